@@ -1,0 +1,67 @@
+#include <keygrid/core/RawlogWriter.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/serialization/CArchive.h>
+#include <mrpt/system/filesystem.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <stdexcept>
+
+namespace keygrid::core
+{
+struct RawlogWriter::Impl
+{
+	mrpt::io::CFileGZOutputStream out;
+};
+
+RawlogWriter::RawlogWriter(const std::string& path, const RawlogWriterOptions& opts)
+	: m_impl(std::make_unique<Impl>()), m_path(path), m_tmpPath(path + ".tmp"), m_opts(opts)
+{
+	const std::string dir = mrpt::system::extractFileDirectory(path);
+	if (!dir.empty() && !mrpt::system::directoryExists(dir))
+		throw std::runtime_error("output folder '" + dir + "' does not exist");
+	if (!m_impl->out.open(m_tmpPath, opts.compressionLevel))
+		throw std::runtime_error("cannot write '" + m_tmpPath + "'");
+	const std::filesystem::path p(path);
+	m_imagesDir = (p.parent_path() / (p.stem().string() + "_Images")).string();
+}
+
+RawlogWriter::~RawlogWriter()
+{
+	if (m_impl && m_impl->out.is_open())
+	{
+		m_impl->out.close();
+		std::remove(m_tmpPath.c_str());
+	}
+}
+
+void RawlogWriter::write(const mrpt::obs::CObservation::Ptr& obs)
+{
+	if (m_opts.externalImages)
+		if (auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(obs);
+			o && o->hasIntensityImage && !o->intensityImage.isExternallyStored())
+		{
+			if (!mrpt::system::directoryExists(m_imagesDir) &&
+				!mrpt::system::createDirectory(m_imagesDir))
+				throw std::runtime_error("cannot create '" + m_imagesDir + "'");
+			char name[64];
+			std::snprintf(name, sizeof(name), "rgb_%06zu.png", m_count);
+			const std::string full = m_imagesDir + "/" + name;
+			if (!o->intensityImage.saveToFile(full))
+				throw std::runtime_error("cannot write '" + full + "'");
+			o->intensityImage.setExternalStorage(name);  // relative to the images dir
+		}
+	auto arch = mrpt::serialization::archiveFrom(m_impl->out);
+	arch << *obs;
+	++m_count;
+}
+
+void RawlogWriter::close()
+{
+	m_impl->out.close();
+	if (std::rename(m_tmpPath.c_str(), m_path.c_str()) != 0)
+		throw std::runtime_error("cannot rename '" + m_tmpPath + "' to '" + m_path + "'");
+}
+
+}  // namespace keygrid::core

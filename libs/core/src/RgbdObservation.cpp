@@ -1,0 +1,150 @@
+#include <keygrid/core/DepthRegistration.h>
+#include <keygrid/core/FrameConventions.h>
+#include <keygrid/core/RgbdObservation.h>
+#include <mrpt/system/datetime.h>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace keygrid::core
+{
+cv::Mat depthRawToMetres(const cv::Mat& raw, float units)
+{
+	CV_Assert(raw.type() == CV_16UC1);
+	cv::Mat m(raw.rows, raw.cols, CV_32FC1);
+	for (int r = 0; r < raw.rows; r++)
+	{
+		const auto* in = raw.ptr<uint16_t>(r);
+		auto* out = m.ptr<float>(r);
+		for (int c = 0; c < raw.cols; c++) out[c] = static_cast<float>(in[c]) * units;
+	}
+	return m;
+}
+
+namespace
+{
+cv::Mat rawFromMetres(const cv::Mat& depth, float units)
+{
+	cv::Mat raw(depth.rows, depth.cols, CV_16UC1);
+	for (int r = 0; r < depth.rows; r++)
+	{
+		const float* in = depth.ptr<float>(r);
+		auto* out = raw.ptr<uint16_t>(r);
+		for (int c = 0; c < depth.cols; c++)
+		{
+			const float d = in[c];
+			if (!(d > 0) || !std::isfinite(d))
+			{
+				out[c] = 0;
+				continue;
+			}
+			const double q = std::round(static_cast<double>(d) / units);
+			if (q > std::numeric_limits<uint16_t>::max())
+				throw std::invalid_argument(
+					"depth " + std::to_string(d) + " m does not fit uint16 at depth_units " +
+					std::to_string(units));
+			out[c] = static_cast<uint16_t>(q);
+		}
+	}
+	return raw;
+}
+}  // namespace
+
+mrpt::obs::CObservation3DRangeScan::Ptr makeRgbdObservation(
+	const Frame& f, const ObservationWriteOptions& opts)
+{
+	const cv::Mat& img = (opts.preferColour && !f.colour.empty()) ? f.colour : f.grey;
+	if (img.empty()) throw std::invalid_argument("frame " + std::to_string(f.index) + " has no image");
+	const cv::Mat raw = !f.depthRaw.empty() ? f.depthRaw
+		: !f.depth.empty()					? rawFromMetres(f.depth, f.camera.depthUnits)
+											: cv::Mat();
+	if (raw.empty()) throw std::invalid_argument("frame " + std::to_string(f.index) + " has no depth");
+	if (raw.type() != CV_16UC1)
+		throw std::invalid_argument("frame " + std::to_string(f.index) + ": raw depth must be CV_16UC1");
+	if (raw.size() != img.size())
+		throw std::invalid_argument(
+			"frame " + std::to_string(f.index) + ": depth " + std::to_string(raw.cols) + "x" +
+			std::to_string(raw.rows) + " and image " + std::to_string(img.cols) + "x" +
+			std::to_string(img.rows) + " differ in size");
+
+	auto obs = mrpt::obs::CObservation3DRangeScan::Create();
+	obs->sensorLabel = opts.sensorLabel;
+	obs->timestamp = mrpt::Clock::fromDouble(f.timestamp);
+	obs->hasRangeImage = true;
+	obs->range_is_depth = true;
+	obs->rangeUnits = f.camera.depthUnits;
+	obs->rangeImage.resize(raw.rows, raw.cols);
+	for (int r = 0; r < raw.rows; r++)
+	{
+		const auto* in = raw.ptr<uint16_t>(r);
+		for (int c = 0; c < raw.cols; c++) obs->rangeImage(r, c) = in[c];
+	}
+	obs->hasIntensityImage = true;
+	obs->intensityImage = mrpt::img::CImage(img, mrpt::img::DEEP_COPY);
+	RgbdCamera cam = f.camera;
+	cam.width = static_cast<unsigned>(img.cols);
+	cam.height = static_cast<unsigned>(img.rows);
+	obs->cameraParams = cam.toTCamera();
+	obs->cameraParamsIntensity = obs->cameraParams;
+	obs->relativePoseIntensityWRTDepth = T_depth_cam();
+	obs->sensorPose = mrpt::poses::CPose3D();
+	obs->maxRange = opts.maxRange;
+	return obs;
+}
+
+bool frameFromObservation(
+	const mrpt::obs::CObservation3DRangeScan& obs, Frame& out, std::string* why)
+{
+	auto fail = [&](const std::string& msg) {
+		if (why) *why = msg;
+		return false;
+	};
+	if (!obs.hasRangeImage || obs.rangeImage.rows() == 0) return fail("observation has no range image");
+	if (!obs.hasIntensityImage || obs.intensityImage.isEmpty())
+		return fail("observation has no intensity image");
+	if (!obs.range_is_depth) return fail("range image holds 3D ranges, not depth (range_is_depth=false)");
+	if (!(obs.rangeUnits > 0) || !std::isfinite(obs.rangeUnits))
+		return fail("invalid rangeUnits " + std::to_string(obs.rangeUnits));
+	const int rows = static_cast<int>(obs.rangeImage.rows());
+	const int cols = static_cast<int>(obs.rangeImage.cols());
+	if (obs.doDepthAndIntensityCamerasCoincide() &&
+		(static_cast<int>(obs.intensityImage.getWidth()) != cols ||
+		 static_cast<int>(obs.intensityImage.getHeight()) != rows))
+		return fail(
+			"intensity image " + std::to_string(obs.intensityImage.getWidth()) + "x" +
+			std::to_string(obs.intensityImage.getHeight()) + " and range image " +
+			std::to_string(cols) + "x" + std::to_string(rows) + " differ in size");
+
+	out.timestamp = mrpt::Clock::toDouble(obs.timestamp);
+	out.camera = RgbdCamera::FromTCamera(obs.cameraParamsIntensity, obs.rangeUnits);
+	out.depthRaw.create(rows, cols, CV_16UC1);
+	for (int r = 0; r < rows; r++)
+	{
+		auto* o = out.depthRaw.ptr<uint16_t>(r);
+		for (int c = 0; c < cols; c++) o[c] = obs.rangeImage(r, c);
+	}
+	// Unregistered sensors (raw Kinect): bring depth into the colour camera, where the frame lives.
+	if (!obs.doDepthAndIntensityCamerasCoincide() || !(obs.cameraParams == obs.cameraParamsIntensity))
+		out.depthRaw = registerDepthToIntensity(
+			out.depthRaw, obs.rangeUnits, obs.cameraParams, obs.cameraParamsIntensity,
+			obs.relativePoseIntensityWRTDepth);
+	out.depth = depthRawToMetres(out.depthRaw, obs.rangeUnits);
+	const cv::Mat& img = obs.intensityImage.asCvMatRef();
+	if (img.channels() == 3)
+	{
+		out.colour = img.clone();
+		cv::cvtColor(img, out.grey, cv::COLOR_BGR2GRAY);
+	}
+	else if (img.channels() == 1)
+	{
+		out.colour.release();
+		out.grey = img.clone();
+	}
+	else
+		return fail("intensity image has " + std::to_string(img.channels()) + " channels");
+	return true;
+}
+
+}  // namespace keygrid::core

@@ -1,0 +1,32 @@
+#pragma once
+/** \file Alignment.h
+ * Closed-form least-squares alignment of two point sets (Horn 1987 / Umeyama 1991).
+ */
+#include <Eigen/Core>
+
+#include <vector>
+
+namespace keygrid::eval
+{
+/** y ~= s * R * x + t */
+struct Similarity3
+{
+	Eigen::Matrix3d R{Eigen::Matrix3d::Identity()};
+	Eigen::Vector3d t{Eigen::Vector3d::Zero()};
+	double s{1.0};
+
+	Eigen::Vector3d apply(const Eigen::Vector3d& x) const { return s * (R * x) + t; }
+};
+
+/** Finds (R, t[, s]) minimising sum_i |y_i - (s R x_i + t)|^2.
+ *
+ * With centroids mx, my and the cross-covariance S = 1/n sum (y_i - my)(x_i - mx)^T = U D V^T,
+ * R = U W V^T with W = diag(1, 1, sign(det(U) det(V))) (a rotation, never a reflection),
+ * s = tr(D W) / var_x when withScale (else 1), and t = my - s R mx.
+ * Requires n >= 3 points (throws std::invalid_argument otherwise). Degenerate sets are
+ * handled: for collinear points the rotation about the line is one of the optima, for
+ * coincident points R = I. */
+Similarity3 alignPointSets(
+	const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y, bool withScale);
+
+}  // namespace keygrid::eval

@@ -1,0 +1,58 @@
+#include <keygrid/eval/Alignment.h>
+
+#include <Eigen/LU>
+#include <Eigen/SVD>
+#include <stdexcept>
+#include <string>
+
+namespace keygrid::eval
+{
+Similarity3 alignPointSets(
+	const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y, bool withScale)
+{
+	if (x.size() != y.size())
+		throw std::invalid_argument(
+			"alignPointSets: " + std::to_string(x.size()) + " vs " + std::to_string(y.size()) +
+			" points");
+	if (x.size() < 3)
+		throw std::invalid_argument(
+			"alignPointSets: need at least 3 matched positions, got " + std::to_string(x.size()));
+	const double n = static_cast<double>(x.size());
+	Eigen::Vector3d mx = Eigen::Vector3d::Zero(), my = Eigen::Vector3d::Zero();
+	for (std::size_t i = 0; i < x.size(); i++)
+	{
+		mx += x[i];
+		my += y[i];
+	}
+	mx /= n;
+	my /= n;
+	Eigen::Matrix3d S = Eigen::Matrix3d::Zero();
+	double varX = 0;
+	for (std::size_t i = 0; i < x.size(); i++)
+	{
+		const Eigen::Vector3d dx = x[i] - mx, dy = y[i] - my;
+		S += dy * dx.transpose();
+		varX += dx.squaredNorm();
+	}
+	S /= n;
+	varX /= n;
+	Eigen::JacobiSVD<Eigen::Matrix3d> svd(S, Eigen::ComputeFullU | Eigen::ComputeFullV);
+	const Eigen::Vector3d D = svd.singularValues();
+	// All points coincide: no rotation can be observed; keep the identity.
+	// (Collinear points leave the roll about the line free; U W V^T is then one of the optima.)
+	if (D(0) <= 1e-15 || varX <= 1e-30)
+	{
+		Similarity3 out;
+		out.t = my - mx;
+		return out;
+	}
+	Eigen::Vector3d w(1, 1, 1);
+	if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) w(2) = -1;
+	Similarity3 out;
+	out.R = svd.matrixU() * w.asDiagonal() * svd.matrixV().transpose();
+	out.s = withScale ? D.dot(w) / varX : 1.0;
+	out.t = my - out.s * out.R * mx;
+	return out;
+}
+
+}  // namespace keygrid::eval
