@@ -20,6 +20,10 @@ function(keygrid_add_library name)
   target_compile_features(keygrid_${name} PUBLIC cxx_std_17)
   target_compile_options(keygrid_${name} PRIVATE -Wall -Wextra)
   target_link_libraries(keygrid_${name} PUBLIC ${ARG_PUBLIC_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  if(KEYGRID_SANITIZE)
+    # Instrumented libraries need the sanitizer runtimes in whatever links them (also consumers).
+    target_link_options(keygrid_${name} INTERFACE -fsanitize=address,undefined)
+  endif()
   install(TARGETS keygrid_${name} EXPORT keygridTargets
     LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR}
     ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
