@@ -1,0 +1,73 @@
+#pragma once
+/** \file FeatureExtractor.h
+ * Keypoints and descriptors of a frame: ORB (default) or SIFT, spread evenly over the image by
+ * grid bucketing, undistorted, with a validated depth per keypoint.
+ */
+#include <keygrid/core/Frame.h>
+#include <keygrid/sfm/FrameFeatures.h>
+#include <opencv2/features2d.hpp>
+
+#include <string>
+
+namespace mrpt::config
+{
+class CConfigFileBase;
+}
+
+namespace keygrid::sfm
+{
+struct FeatureOptions
+{
+	/** "orb" or "sift" (Default: orb) */
+	std::string type{"orb"};
+	/** Keypoints kept per frame after bucketing (Default: 1000) */
+	int numFeatures{1000};
+	/** Pyramid scale step (Default: 1.2) */
+	double scaleFactor{1.2};
+	/** Pyramid levels (Default: 8) */
+	int numLevels{8};
+	/** FAST threshold for ORB (Default: 20) */
+	int fastThreshold{20};
+	/** Candidates detected per kept keypoint before bucketing (Default: 2.0) */
+	double oversampling{2.0};
+	/** Bucketing grid: columns x rows of cells sharing the keypoint budget (Default: 8 x 6) */
+	int gridCols{8}, gridRows{6};
+	/** Valid depth range [m] (Default: 0.3 .. 6.0 m) */
+	double minDepth{0.3}, maxDepth{6.0};
+	/** A depth is rejected when the 3x3 neighbourhood spans more than this fraction of it,
+	 * i.e. the keypoint sits on a depth discontinuity (Default: 0.05) */
+	double maxDepthDiscontinuity{0.05};
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	bool isValid(std::string* error = nullptr) const;
+};
+
+class FeatureExtractor
+{
+   public:
+	explicit FeatureExtractor(const FeatureOptions& opts);
+
+	/** Detects, buckets, describes, undistorts and looks up depth. Thread-compatible: one
+	 * extractor per thread. */
+	FrameFeatures extract(const core::Frame& frame) const;
+
+	const FeatureOptions& options() const { return m_opts; }
+	/** Scale of pyramid level l (scaleFactor^l). */
+	double levelScale(int level) const;
+
+	/** Depth at a raw (distorted) pixel with the validity checks of the options, 0 if invalid. */
+	float depthAt(const cv::Mat& depth, float u, float v) const;
+
+   private:
+	FeatureOptions m_opts;
+	cv::Ptr<cv::Feature2D> m_detector;
+	std::vector<double> m_levelScale;
+};
+
+/** Keeps at most `budget` keypoints spread over a cols x rows grid: each cell first keeps its
+ * strongest `budget / cells`, then the remaining budget goes to the strongest leftovers. */
+std::vector<cv::KeyPoint> bucketKeypoints(
+	const std::vector<cv::KeyPoint>& kps, cv::Size imageSize, int cols, int rows, int budget);
+
+}  // namespace keygrid::sfm

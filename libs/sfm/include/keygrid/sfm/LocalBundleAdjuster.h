@@ -1,0 +1,50 @@
+#pragma once
+/** \file LocalBundleAdjuster.h
+ * Local bundle adjustment around a keyframe: the keyframe and its covisible neighbours and all
+ * landmarks they see are optimised; keyframes that also see those landmarks stay fixed.
+ * Ceres, Huber loss, Schur complement with SuiteSparse when available.
+ */
+#include <keygrid/sfm/PoseOptimizer.h>
+#include <keygrid/sfm/SparseMap.h>
+
+#include <string>
+
+namespace mrpt::config
+{
+class CConfigFileBase;
+}
+
+namespace keygrid::sfm
+{
+struct BundleAdjusterOptions
+{
+	/** Covisible keyframes optimised with the current one (Default: 10) */
+	int windowSize{10};
+	/** Fixed keyframes kept at most, the most covisible first (Default: 10) */
+	int maxFixedKeyFrames{10};
+	/** Levenberg-Marquardt iterations (Default: 10) */
+	int iterations{10};
+	/** Chi-square outlier thresholds after the solve (Default: 5.991 / 7.815) */
+	double chi2Mono{5.991}, chi2Rgbd{7.815};
+	/** Virtual stereo baseline x fx for depth residuals (Default: 40) */
+	double bf{40.0};
+	/** Depth residuals only for depths below this [m] (Default: 6) */
+	double maxDepthForRgbd{6.0};
+	/** Threads used by Ceres (Default: 1; results are then deterministic) */
+	int threads{1};
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+};
+
+struct BundleAdjusterReport
+{
+	int keyframes{0}, fixedKeyFrames{0}, landmarks{0}, observations{0}, outliersRemoved{0};
+	double initialCost{0}, finalCost{0};
+};
+
+/** Optimises the window around `kf` in place and removes outlier observations. */
+BundleAdjusterReport localBundleAdjustment(
+	SparseMap& map, KeyFrameId kf, const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);
+
+}  // namespace keygrid::sfm

@@ -1,0 +1,116 @@
+#pragma once
+/** \file SparseMap.h
+ * Keyframes and landmarks of the SfM frontend, and the covisibility graph between keyframes.
+ * A plain container: the algorithms that change it (Tracker, LocalMapper, bundle adjustment)
+ * live in their own classes. Ids are monotonic, containers ordered, so iteration (and every
+ * result built from it) is deterministic.
+ */
+#include <keygrid/sfm/FrameFeatures.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <map>
+#include <mutex>
+#include <vector>
+
+namespace keygrid::sfm
+{
+using KeyFrameId = std::uint64_t;
+using LandmarkId = std::uint64_t;
+constexpr LandmarkId kNoLandmark = ~LandmarkId(0);
+
+struct Landmark
+{
+	LandmarkId id{0};
+	Eigen::Vector3d p_world{Eigen::Vector3d::Zero()};
+	/** Representative descriptor: the one with the least median distance to the others. */
+	cv::Mat descriptor;
+	/** keyframe -> index of the keypoint observing this landmark there */
+	std::map<KeyFrameId, int> observations;
+	/** Mean viewing direction (unit, world frame, from cameras towards the point). */
+	Eigen::Vector3d normal{Eigen::Vector3d::Zero()};
+	/** Distances within which ORB's scale invariance holds [m]. */
+	double minDistance{0}, maxDistance{0};
+	KeyFrameId firstKeyFrame{0};
+	/** Frames where it was predicted in view / actually matched (for culling). */
+	int visibleCount{1}, foundCount{1};
+
+	double foundRatio() const { return static_cast<double>(foundCount) / std::max(1, visibleCount); }
+};
+
+struct KeyFrame
+{
+	KeyFrameId id{0};
+	std::size_t frameIndex{0};
+	double timestamp{0};
+	mrpt::poses::CPose3D T_world_cam;
+	FrameFeatures features;
+	/** Landmark of each keypoint, kNoLandmark if none. */
+	std::vector<LandmarkId> landmarks;
+	/** Depth image [m] (kept for the dense maps; shares the frame's buffer). */
+	cv::Mat depth;
+	/** Covisibility: other keyframe -> number of shared landmarks (>= threshold). */
+	std::map<KeyFrameId, int> covisibility;
+	/** Keyframe that was the reference when this one was created (spanning tree parent). */
+	KeyFrameId parent{0};
+	bool hasParent{false};
+
+	Eigen::Vector3d cameraCenter() const;
+	int trackedLandmarks(int minObservations = 1, const class SparseMap* map = nullptr) const;
+};
+
+class SparseMap
+{
+   public:
+	/** Adds a keyframe (its id is assigned here) and returns it. */
+	KeyFrame& addKeyFrame(KeyFrame kf);
+	/** Creates a landmark observed by keypoint kp of keyframe kf. */
+	LandmarkId addLandmark(const Eigen::Vector3d& p_world, KeyFrameId kf, int kp);
+	void addObservation(LandmarkId lm, KeyFrameId kf, int kp);
+	void eraseObservation(LandmarkId lm, KeyFrameId kf);
+	void eraseLandmark(LandmarkId lm);
+	/** Removes a keyframe and its observations; landmarks left with < 1 observation go too.
+	 * Its pose relative to its parent is remembered (see poseOf) so that frames referencing it
+	 * still get a pose that follows later map refinements. */
+	void eraseKeyFrame(KeyFrameId kf);
+	/** Pose of a keyframe, also of an erased one (through its parent chain); false if unknown. */
+	bool poseOf(KeyFrameId kf, mrpt::poses::CPose3D& T_world_kf) const;
+	/** Keeps `keep`, moves the observations of `gone` to it (duplicate fusion). */
+	void replaceLandmark(LandmarkId gone, LandmarkId keep);
+
+	/** Recomputes normal, distance limits and representative descriptor of a landmark. */
+	void updateLandmarkStats(LandmarkId lm);
+	/** Recomputes the covisibility edges of kf (and the reverse edges). */
+	void updateCovisibility(KeyFrameId kf, int minShared = 15);
+	/** Up to n covisible keyframes by decreasing weight. */
+	std::vector<KeyFrameId> bestCovisibles(KeyFrameId kf, std::size_t n) const;
+
+	bool hasKeyFrame(KeyFrameId id) const { return m_keyframes.count(id) > 0; }
+	bool hasLandmark(LandmarkId id) const { return m_landmarks.count(id) > 0; }
+	KeyFrame& keyframe(KeyFrameId id) { return m_keyframes.at(id); }
+	const KeyFrame& keyframe(KeyFrameId id) const { return m_keyframes.at(id); }
+	Landmark& landmark(LandmarkId id) { return m_landmarks.at(id); }
+	const Landmark& landmark(LandmarkId id) const { return m_landmarks.at(id); }
+	const std::map<KeyFrameId, KeyFrame>& keyframes() const { return m_keyframes; }
+	const std::map<LandmarkId, Landmark>& landmarks() const { return m_landmarks; }
+	std::size_t numKeyFrames() const { return m_keyframes.size(); }
+	std::size_t numLandmarks() const { return m_landmarks.size(); }
+
+	/** The map's own lock, for threaded mode (tracking and mapping on separate threads). */
+	std::mutex& mutex() const { return m_mutex; }
+
+   private:
+	std::map<KeyFrameId, KeyFrame> m_keyframes;
+	std::map<LandmarkId, Landmark> m_landmarks;
+	/** erased keyframe -> (parent, T_parent_kf) */
+	std::map<KeyFrameId, std::pair<KeyFrameId, mrpt::poses::CPose3D>> m_erased;
+	KeyFrameId m_nextKf{0};
+	LandmarkId m_nextLm{0};
+	mutable std::mutex m_mutex;
+};
+
+/** Eigen position of a CPose3D translation. */
+inline Eigen::Vector3d translationOf(const mrpt::poses::CPose3D& p) { return {p.x(), p.y(), p.z()}; }
+
+}  // namespace keygrid::sfm

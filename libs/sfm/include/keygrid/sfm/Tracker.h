@@ -1,0 +1,97 @@
+#pragma once
+/** \file Tracker.h
+ * Frame-to-map tracking: constant-velocity prediction, projection search against the local
+ * map, Ceres pose refinement; PnP-RANSAC fallback and relocalization; keyframe decisions.
+ * The tracker only creates keyframes and their new landmarks; refining the map around them
+ * is the LocalMapper's job.
+ */
+#include <keygrid/core/Frame.h>
+#include <keygrid/sfm/SparseMap.h>
+#include <keygrid/sfm/TrackerOptions.h>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace keygrid::sfm
+{
+enum class TrackingState
+{
+	NotInitialized,
+	Ok,
+	Lost
+};
+
+/** What happened to one frame. */
+struct TrackedFrame
+{
+	std::size_t index{0};
+	double timestamp{0};
+	mrpt::poses::CPose3D T_world_cam;
+	bool tracked{false};
+	/** "init", "prediction", "pnp", "relocalization" or "lost" */
+	std::string method;
+	int matches{0}, inliers{0};
+	bool newKeyFrame{false};
+	KeyFrameId keyframe{0};  //!< the new keyframe when newKeyFrame
+	/** Pose relative to the reference keyframe, so the final trajectory follows map refinements. */
+	KeyFrameId reference{0};
+	mrpt::poses::CPose3D T_ref_cam;
+	bool hasReference{false};
+};
+
+class Tracker
+{
+   public:
+	Tracker(SparseMap& map, const TrackerOptions& opts);
+
+	/** Tracks one frame whose features were extracted by the caller. In threaded mode the
+	 * caller holds map.mutex() around this call. */
+	TrackedFrame track(const core::Frame& frame, FrameFeatures features);
+
+	TrackingState state() const { return m_state; }
+	const TrackerOptions& options() const { return m_opts; }
+	/** Landmarks matched as inliers in the last frame (for diagnostics and the maps). */
+	const std::vector<LandmarkId>& lastInlierLandmarks() const { return m_lastInliers; }
+
+   private:
+	struct Current
+	{
+		const core::Frame* frame{nullptr};
+		FrameFeatures features;
+		std::vector<LandmarkId> matches;
+		mrpt::poses::CPose3D T_world_cam;
+		int inliers{0};
+	};
+
+	bool initialize(Current& cur, TrackedFrame& out);
+	bool trackByPrediction(Current& cur);
+	bool trackByPnp(Current& cur, KeyFrameId kf, int minInliers);
+	bool relocalize(Current& cur);
+	/** Projects the local map's unmatched landmarks, matches, refines; returns inliers. */
+	int trackLocalMap(Current& cur, float radius);
+	/** Refines cur.T_world_cam from cur.matches; drops outlier matches; returns inliers. */
+	int refinePose(Current& cur);
+	void updateLocalKeyFrames(const Current& cur);
+	std::vector<ProjectedLandmark> projectLocalLandmarks(const Current& cur, bool countVisible);
+	bool needKeyFrame(const Current& cur) const;
+	KeyFrameId createKeyFrame(const Current& cur);
+
+	SparseMap& m_map;
+	TrackerOptions m_opts;
+	TrackingState m_state{TrackingState::NotInitialized};
+	PinholeIntrinsics m_K;
+	mrpt::poses::CPose3D m_lastPose;
+	std::optional<mrpt::poses::CPose3D> m_velocity;  //!< T_last_cur of the last tracked step
+	KeyFrameId m_refKf{0};
+	std::size_t m_lastKfFrame{0};
+	std::vector<KeyFrameId> m_localKfs;
+	std::vector<LandmarkId> m_lastInliers;
+	int m_framesLost{0};
+};
+
+/** Back-projects an undistorted pixel with depth into the camera frame. */
+Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float depth);
+PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& cam);
+
+}  // namespace keygrid::sfm

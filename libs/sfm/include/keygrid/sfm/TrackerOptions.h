@@ -1,0 +1,56 @@
+#pragma once
+/** \file TrackerOptions.h
+ * Parameters of frame tracking and keyframe selection.
+ */
+#include <keygrid/sfm/Matcher.h>
+#include <keygrid/sfm/PnpSolver.h>
+#include <keygrid/sfm/PoseOptimizer.h>
+
+#include <string>
+
+namespace mrpt::config
+{
+class CConfigFileBase;
+}
+
+namespace keygrid::sfm
+{
+struct TrackerOptions
+{
+	/** Keypoints with valid depth needed to initialise the map (Default: 300) */
+	int minInitFeatures{300};
+	/** Search radius around the motion-model prediction [px at level 0] (Default: 12) */
+	float radiusPrediction{12.f};
+	/** Search radius when refining against the local map [px at level 0] (Default: 4) */
+	float radiusLocalMap{4.f};
+	/** Matches below which the wide search / PnP fallback starts (Default: 30) */
+	int minMatchesPrediction{30};
+	/** Inliers needed to call a frame tracked (Default: 25) */
+	int minInliers{25};
+	/** Covisible keyframes forming the local map (Default: 20) */
+	int localKeyFrames{20};
+	/** Keyframes tried (newest first) when relocalizing (Default: 20) */
+	int relocalizationCandidates{20};
+
+	/** A keyframe at the latest after this many frames (Default: 30) */
+	int maxFramesBetweenKeyFrames{30};
+	/** Insert when tracked landmarks fall below this fraction of the reference keyframe's (Default: 0.75) */
+	double keyFrameTrackedRatio{0.75};
+	/** Depth under which points count as "close" (well-measured) [m] (Default: 3.0) */
+	double closeDepth{3.0};
+	/** Insert when fewer close points are tracked than this and ... (Default: 100) */
+	int minTrackedClose{100};
+	/** ... at least this many untracked close points could become landmarks (Default: 70) */
+	int minNewClose{70};
+	/** New landmarks per keyframe: all close ones, and farther ones up to this total (Default: 100) */
+	int minNewLandmarksPerKeyFrame{100};
+
+	MatcherOptions matcher;
+	PoseOptimizerOptions pose;
+	PnpOptions pnp;
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+};
+
+}  // namespace keygrid::sfm

@@ -1,0 +1,174 @@
+#include <keygrid/sfm/FeatureExtractor.h>
+#include <mrpt/config/CConfigFileBase.h>
+#include <opencv2/calib3d.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace keygrid::sfm
+{
+void FeatureOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	type = c.read_string(s, "type", type);
+	numFeatures = c.read_int(s, "num_features", numFeatures);
+	scaleFactor = c.read_double(s, "scale_factor", scaleFactor);
+	numLevels = c.read_int(s, "num_levels", numLevels);
+	fastThreshold = c.read_int(s, "fast_threshold", fastThreshold);
+	oversampling = c.read_double(s, "oversampling", oversampling);
+	gridCols = c.read_int(s, "grid_cols", gridCols);
+	gridRows = c.read_int(s, "grid_rows", gridRows);
+	minDepth = c.read_double(s, "min_depth", minDepth);
+	maxDepth = c.read_double(s, "max_depth", maxDepth);
+	maxDepthDiscontinuity = c.read_double(s, "max_depth_discontinuity", maxDepthDiscontinuity);
+	std::string err;
+	if (!isValid(&err)) throw std::invalid_argument("[" + s + "] " + err);
+}
+
+void FeatureOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	c.write(s, "type", type, 30, 40, "orb | sift");
+	c.write(s, "num_features", numFeatures, 30, 40, "keypoints kept per frame");
+	c.write(s, "scale_factor", scaleFactor, 30, 40, "pyramid scale step");
+	c.write(s, "num_levels", numLevels, 30, 40, "pyramid levels");
+	c.write(s, "fast_threshold", fastThreshold, 30, 40, "ORB FAST threshold");
+	c.write(s, "oversampling", oversampling, 30, 40, "candidates per kept keypoint before bucketing");
+	c.write(s, "grid_cols", gridCols, 30, 40, "bucketing grid columns");
+	c.write(s, "grid_rows", gridRows, 30, 40, "bucketing grid rows");
+	c.write(s, "min_depth", minDepth, 30, 40, "valid depth range, lower end [m]");
+	c.write(s, "max_depth", maxDepth, 30, 40, "valid depth range, upper end [m]");
+	c.write(s, "max_depth_discontinuity", maxDepthDiscontinuity, 30, 40, "3x3 depth span / depth above which depth is rejected");
+}
+
+bool FeatureOptions::isValid(std::string* error) const
+{
+	std::ostringstream e;
+	if (type != "orb" && type != "sift") e << "type = '" << type << "' (expected orb or sift)";
+	else if (numFeatures < 10) e << "num_features = " << numFeatures << " (must be >= 10)";
+	else if (!(scaleFactor > 1.0 && scaleFactor < 2.0)) e << "scale_factor = " << scaleFactor << " (must be in (1, 2))";
+	else if (numLevels < 1 || numLevels > 16) e << "num_levels = " << numLevels << " (must be 1..16)";
+	else if (oversampling < 1.0) e << "oversampling = " << oversampling << " (must be >= 1)";
+	else if (gridCols < 1 || gridRows < 1) e << "grid_cols/grid_rows must be >= 1";
+	else if (!(minDepth >= 0 && maxDepth > minDepth)) e << "min_depth/max_depth = " << minDepth << "/" << maxDepth;
+	else if (!(maxDepthDiscontinuity > 0)) e << "max_depth_discontinuity must be > 0";
+	if (error) *error = e.str();
+	return e.str().empty();
+}
+
+std::vector<cv::KeyPoint> bucketKeypoints(
+	const std::vector<cv::KeyPoint>& kps, cv::Size size, int cols, int rows, int budget)
+{
+	if (static_cast<int>(kps.size()) <= budget) return kps;
+	const int cells = cols * rows;
+	std::vector<std::vector<int>> byCell(static_cast<std::size_t>(cells));
+	for (std::size_t i = 0; i < kps.size(); i++)
+	{
+		const int cx = std::clamp(static_cast<int>(kps[i].pt.x * cols / size.width), 0, cols - 1);
+		const int cy = std::clamp(static_cast<int>(kps[i].pt.y * rows / size.height), 0, rows - 1);
+		byCell[static_cast<std::size_t>(cy) * cols + cx].push_back(static_cast<int>(i));
+	}
+	auto stronger = [&](int a, int b) {
+		// Ties broken by position so the result never depends on input order.
+		if (kps[a].response != kps[b].response) return kps[a].response > kps[b].response;
+		if (kps[a].pt.y != kps[b].pt.y) return kps[a].pt.y < kps[b].pt.y;
+		return kps[a].pt.x < kps[b].pt.x;
+	};
+	const int perCell = std::max(1, budget / cells);
+	std::vector<int> kept, rest;
+	for (auto& cell : byCell)
+	{
+		std::sort(cell.begin(), cell.end(), stronger);
+		for (std::size_t k = 0; k < cell.size(); k++) (static_cast<int>(k) < perCell ? kept : rest).push_back(cell[k]);
+	}
+	if (static_cast<int>(kept.size()) > budget)
+	{
+		std::sort(kept.begin(), kept.end(), stronger);
+		kept.resize(static_cast<std::size_t>(budget));
+	}
+	else
+	{
+		std::sort(rest.begin(), rest.end(), stronger);
+		for (std::size_t k = 0; k < rest.size() && static_cast<int>(kept.size()) < budget; k++) kept.push_back(rest[k]);
+	}
+	std::sort(kept.begin(), kept.end());
+	std::vector<cv::KeyPoint> out;
+	out.reserve(kept.size());
+	for (int i : kept) out.push_back(kps[i]);
+	return out;
+}
+
+FeatureExtractor::FeatureExtractor(const FeatureOptions& o) : m_opts(o)
+{
+	std::string err;
+	if (!o.isValid(&err)) throw std::invalid_argument("FeatureOptions: " + err);
+	const int n = static_cast<int>(std::ceil(o.numFeatures * o.oversampling));
+	if (o.type == "orb")
+		m_detector = cv::ORB::create(
+			n, static_cast<float>(o.scaleFactor), o.numLevels, 19, 0, 2, cv::ORB::HARRIS_SCORE, 31,
+			o.fastThreshold);
+	else
+		m_detector = cv::SIFT::create(n);
+	for (int l = 0; l < std::max(o.numLevels, 16); l++) m_levelScale.push_back(std::pow(o.scaleFactor, l));
+}
+
+double FeatureExtractor::levelScale(int level) const
+{
+	return m_levelScale.at(static_cast<std::size_t>(std::clamp(level, 0, static_cast<int>(m_levelScale.size()) - 1)));
+}
+
+float FeatureExtractor::depthAt(const cv::Mat& depth, float u, float v) const
+{
+	const int c = static_cast<int>(std::lround(u)), r = static_cast<int>(std::lround(v));
+	if (c < 1 || r < 1 || c >= depth.cols - 1 || r >= depth.rows - 1) return 0.f;
+	const float d = depth.at<float>(r, c);
+	if (!(d >= m_opts.minDepth && d <= m_opts.maxDepth)) return 0.f;
+	float lo = d, hi = d;
+	for (int dr = -1; dr <= 1; dr++)
+		for (int dc = -1; dc <= 1; dc++)
+		{
+			const float x = depth.at<float>(r + dr, c + dc);
+			if (x <= 0) continue;  // holes next to a valid pixel are common; not an edge by themselves
+			lo = std::min(lo, x);
+			hi = std::max(hi, x);
+		}
+	return (hi - lo) > m_opts.maxDepthDiscontinuity * d ? 0.f : d;
+}
+
+FrameFeatures FeatureExtractor::extract(const core::Frame& frame) const
+{
+	if (frame.grey.empty()) throw std::invalid_argument("FeatureExtractor: frame has no image");
+	FrameFeatures f;
+	f.camera = frame.camera;
+	f.levelScale = m_levelScale;
+	f.numLevels = m_opts.numLevels;
+	std::vector<cv::KeyPoint> all;
+	m_detector->detect(frame.grey, all);
+	f.keypoints = bucketKeypoints(all, frame.grey.size(), m_opts.gridCols, m_opts.gridRows, m_opts.numFeatures);
+	m_detector->compute(frame.grey, f.keypoints, f.descriptors);
+	if (m_opts.type == "sift")
+	{
+		// Pyramid level from the keypoint scale, so matching windows work as for ORB.
+		const double base = 3.2, ls = std::log(m_opts.scaleFactor);
+		for (auto& kp : f.keypoints)
+			kp.octave = std::clamp(static_cast<int>(std::lround(std::log(std::max(kp.size, 1.f) / base) / ls)), 0, m_opts.numLevels - 1);
+	}
+	const std::size_t n = f.keypoints.size();
+	std::vector<cv::Point2f> raw(n);
+	for (std::size_t i = 0; i < n; i++) raw[i] = f.keypoints[i].pt;
+	if (frame.camera.hasDistortion() && n > 0)
+	{
+		const cv::Matx33d K(frame.camera.fx, 0, frame.camera.cx, 0, frame.camera.fy, frame.camera.cy, 0, 0, 1);
+		const std::vector<double> D(frame.camera.dist.begin(), frame.camera.dist.end());
+		cv::undistortPoints(raw, f.undistorted, K, D, cv::noArray(), K);
+	}
+	else
+		f.undistorted = raw;
+	f.depth.assign(n, 0.f);
+	if (!frame.depth.empty())
+		for (std::size_t i = 0; i < n; i++) f.depth[i] = depthAt(frame.depth, raw[i].x, raw[i].y);
+	f.buildGrid();
+	return f;
+}
+
+}  // namespace keygrid::sfm

@@ -1,0 +1,173 @@
+#include <keygrid/sfm/LocalMapper.h>
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <algorithm>
+#include <set>
+
+namespace keygrid::sfm
+{
+void LocalMapperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	fuseNeighbours = c.read_int(s, "fuse_neighbours", fuseNeighbours);
+	fuseRadius = c.read_float(s, "fuse_radius", fuseRadius);
+	fuseMaxDistanceOrb = c.read_float(s, "fuse_max_distance_orb", fuseMaxDistanceOrb);
+	minFoundRatio = c.read_double(s, "min_found_ratio", minFoundRatio);
+	redundantKeyFrameRatio = c.read_double(s, "redundant_keyframe_ratio", redundantKeyFrameRatio);
+	localBundleAdjustment = c.read_bool(s, "local_bundle_adjustment", localBundleAdjustment);
+	if (fuseNeighbours < 0) throw std::invalid_argument("[" + s + "] fuse_neighbours must be >= 0");
+	if (!(redundantKeyFrameRatio > 0 && redundantKeyFrameRatio <= 1.0))
+		throw std::invalid_argument("[" + s + "] redundant_keyframe_ratio = " + std::to_string(redundantKeyFrameRatio) + " (must be in (0, 1])");
+	ba.loadFromConfigFile(c, s);
+}
+
+void LocalMapperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	c.write(s, "fuse_neighbours", fuseNeighbours, 30, 40, "neighbour keyframes searched for duplicates");
+	c.write(s, "fuse_radius", fuseRadius, 30, 40, "fusion search radius [px]");
+	c.write(s, "fuse_max_distance_orb", fuseMaxDistanceOrb, 30, 40, "fusion descriptor threshold [bits]");
+	c.write(s, "min_found_ratio", minFoundRatio, 30, 40, "new landmarks matched less often are culled");
+	c.write(s, "redundant_keyframe_ratio", redundantKeyFrameRatio, 30, 40, "keyframes this redundant are culled");
+	c.write(s, "local_bundle_adjustment", localBundleAdjustment, 30, 40, "");
+	ba.saveToConfigFile(c, s);
+}
+
+LocalMapper::LocalMapper(SparseMap& map, const LocalMapperOptions& opts, const MatcherOptions& matcher)
+	: m_map(map), m_opts(opts), m_matcher(matcher)
+{
+}
+
+LocalMappingReport LocalMapper::process(KeyFrameId kf, const PinholeIntrinsics& K)
+{
+	LocalMappingReport rep;
+	// Landmarks created by this keyframe join the probation list.
+	for (LandmarkId l : m_map.keyframe(kf).landmarks)
+		if (l != kNoLandmark && m_map.hasLandmark(l) && m_map.landmark(l).firstKeyFrame == kf) m_recent.push_back(l);
+	rep.culledLandmarks = cullRecentLandmarks(kf);
+	if (m_map.numKeyFrames() > 1)
+	{
+		fuse(kf, K, rep);
+		m_map.updateCovisibility(kf);
+		if (m_opts.localBundleAdjustment) rep.ba = localBundleAdjustment(m_map, kf, K, m_opts.ba);
+		rep.culledKeyFrames = cullKeyFrames(kf);
+	}
+	return rep;
+}
+
+int LocalMapper::cullRecentLandmarks(KeyFrameId current)
+{
+	int culled = 0;
+	std::deque<LandmarkId> keep;
+	for (LandmarkId id : m_recent)
+	{
+		if (!m_map.hasLandmark(id)) continue;
+		const auto& l = m_map.landmark(id);
+		const KeyFrameId age = current - l.firstKeyFrame;
+		if (l.foundRatio() < m_opts.minFoundRatio || (age >= 2 && l.observations.size() < 2))
+		{
+			m_map.eraseLandmark(id);
+			++culled;
+		}
+		else if (age < 3)
+			keep.push_back(id);  // still on probation
+	}
+	m_recent.swap(keep);
+	return culled;
+}
+
+void LocalMapper::fuseInto(
+	KeyFrameId target, const std::vector<LandmarkId>& lms, const PinholeIntrinsics& K, LocalMappingReport& rep)
+{
+	auto& kf = m_map.keyframe(target);
+	const auto& f = kf.features;
+	const auto T_cam_world = -kf.T_world_cam;
+	const Eigen::Vector3d center = kf.cameraCenter();
+	const float maxDist = f.isBinary() ? m_opts.fuseMaxDistanceOrb : m_matcher.maxDistanceSift * 0.8f;
+	for (LandmarkId id : lms)
+	{
+		if (!m_map.hasLandmark(id)) continue;
+		const auto& lm = m_map.landmark(id);
+		if (lm.observations.count(target)) continue;
+		ProjectedLandmark p;
+		if (!projectLandmark(lm, T_cam_world, center, K, f, m_matcher, p)) continue;
+		const float r = m_opts.fuseRadius * static_cast<float>(f.levelScale[p.predictedLevel]);
+		int best = -1;
+		float bestD = maxDist + 1;
+		for (int i : f.featuresInArea(p.u, p.v, r, std::max(0, p.predictedLevel - 1), p.predictedLevel + 1))
+		{
+			const float d = f.depth[i];
+			if (d > 0 && std::abs(d - p.depth) > m_matcher.maxDepthError * p.depth) continue;
+			const float dist = descriptorDistance(lm.descriptor, f.descriptors.row(i));
+			if (dist < bestD)
+			{
+				bestD = dist;
+				best = i;
+			}
+		}
+		if (best < 0 || bestD > maxDist) continue;
+		const LandmarkId there = kf.landmarks[best];
+		if (there == kNoLandmark || !m_map.hasLandmark(there))
+		{
+			m_map.addObservation(id, target, best);
+			rep.addedObservations++;
+		}
+		else if (there != id)
+		{
+			// Duplicates: keep the better-observed landmark.
+			const bool keepThere = m_map.landmark(there).observations.size() >= lm.observations.size();
+			m_map.replaceLandmark(keepThere ? id : there, keepThere ? there : id);
+			rep.fusedLandmarks++;
+		}
+	}
+}
+
+void LocalMapper::fuse(KeyFrameId kfId, const PinholeIntrinsics& K, LocalMappingReport& rep)
+{
+	const auto neighbours = m_map.bestCovisibles(kfId, static_cast<std::size_t>(m_opts.fuseNeighbours));
+	std::vector<LandmarkId> mine;
+	for (LandmarkId l : m_map.keyframe(kfId).landmarks)
+		if (l != kNoLandmark) mine.push_back(l);
+	for (KeyFrameId n : neighbours) fuseInto(n, mine, K, rep);
+	std::vector<LandmarkId> theirs;
+	std::set<LandmarkId> seen;
+	for (KeyFrameId n : neighbours)
+		for (LandmarkId l : m_map.keyframe(n).landmarks)
+			if (l != kNoLandmark && seen.insert(l).second) theirs.push_back(l);
+	fuseInto(kfId, theirs, K, rep);
+	for (LandmarkId l : m_map.keyframe(kfId).landmarks)
+		if (l != kNoLandmark && m_map.hasLandmark(l)) m_map.updateLandmarkStats(l);
+	for (KeyFrameId n : neighbours) m_map.updateCovisibility(n);
+}
+
+int LocalMapper::cullKeyFrames(KeyFrameId current)
+{
+	int culled = 0;
+	const KeyFrameId first = m_map.keyframes().begin()->first;
+	for (KeyFrameId id : m_map.bestCovisibles(current, 30))
+	{
+		if (id == first || id == current || !m_map.hasKeyFrame(id)) continue;
+		const auto& kf = m_map.keyframe(id);
+		int total = 0, redundant = 0;
+		for (std::size_t i = 0; i < kf.landmarks.size(); i++)
+		{
+			const LandmarkId l = kf.landmarks[i];
+			if (l == kNoLandmark || !m_map.hasLandmark(l)) continue;
+			++total;
+			const int level = kf.features.keypoints[i].octave;
+			int others = 0;
+			for (const auto& [okf, okp] : m_map.landmark(l).observations)
+			{
+				if (okf == id) continue;
+				if (m_map.keyframe(okf).features.keypoints[okp].octave <= level + 1 && ++others >= 3) break;
+			}
+			if (others >= 3) ++redundant;
+		}
+		if (total > 0 && redundant > m_opts.redundantKeyFrameRatio * total)
+		{
+			m_map.eraseKeyFrame(id);
+			++culled;
+		}
+	}
+	return culled;
+}
+
+}  // namespace keygrid::sfm

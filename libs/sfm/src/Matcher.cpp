@@ -1,0 +1,104 @@
+#include <keygrid/sfm/Matcher.h>
+#include <opencv2/features2d.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+namespace keygrid::sfm
+{
+int predictLevel(const Landmark& lm, double dist, const FrameFeatures& f)
+{
+	const int nLevels = f.numLevels;
+	if (dist <= 0 || lm.maxDistance <= 0 || f.levelScale.size() < 2) return 0;
+	const double ratio = lm.maxDistance / dist;
+	const int level = static_cast<int>(std::ceil(std::log(ratio) / std::log(f.levelScale[1])));
+	return std::clamp(level, 0, nLevels - 1);
+}
+
+bool projectLandmark(
+	const Landmark& lm, const mrpt::poses::CPose3D& T_cam_world, const Eigen::Vector3d& center,
+	const PinholeIntrinsics& K, const FrameFeatures& f, const MatcherOptions& o, ProjectedLandmark& out)
+{
+	double x, y, z;
+	T_cam_world.composePoint(lm.p_world.x(), lm.p_world.y(), lm.p_world.z(), x, y, z);
+	if (z <= 0.05) return false;
+	const double u = K.fx * x / z + K.cx, v = K.fy * y / z + K.cy;
+	const double margin = 2.0;
+	if (u < -margin || v < -margin || u > f.camera.width + margin || v > f.camera.height + margin) return false;
+	const Eigen::Vector3d ray = lm.p_world - center;
+	const double dist = ray.norm();
+	if (lm.maxDistance > 0 && (dist < 0.8 * lm.minDistance || dist > 1.2 * lm.maxDistance)) return false;
+	if (lm.normal.squaredNorm() > 0 && ray.dot(lm.normal) < o.minViewCosine * dist) return false;
+	out.id = lm.id;
+	out.p_world = lm.p_world;
+	out.u = static_cast<float>(u);
+	out.v = static_cast<float>(v);
+	out.depth = static_cast<float>(z);
+	out.predictedLevel = predictLevel(lm, dist, f);
+	out.descriptor = &lm.descriptor;
+	return true;
+}
+
+int searchByProjection(
+	const FrameFeatures& f, const std::vector<ProjectedLandmark>& cands, float radius,
+	const MatcherOptions& o, std::vector<LandmarkId>& matches)
+{
+	const float maxDist = o.maxDistance(f.isBinary());
+	int added = 0;
+	for (const auto& c : cands)
+	{
+		const float r = radius * static_cast<float>(f.levelScale.empty() ? 1.0 : f.levelScale[c.predictedLevel]);
+		const auto idx = f.featuresInArea(c.u, c.v, r, std::max(0, c.predictedLevel - 1), c.predictedLevel + 1);
+		float best = 1e30f, second = 1e30f;
+		int bestIdx = -1, bestLevel = -1, secondLevel = -1;
+		for (int i : idx)
+		{
+			if (matches[i] != kNoLandmark) continue;
+			const float d = f.depth[i];
+			if (d > 0 && std::abs(d - c.depth) > o.maxDepthError * c.depth) continue;
+			const float dist = descriptorDistance(*c.descriptor, f.descriptors.row(i));
+			if (dist < best)
+			{
+				second = best;
+				secondLevel = bestLevel;
+				best = dist;
+				bestIdx = i;
+				bestLevel = f.keypoints[i].octave;
+			}
+			else if (dist < second)
+			{
+				second = dist;
+				secondLevel = f.keypoints[i].octave;
+			}
+		}
+		if (bestIdx < 0 || best > maxDist) continue;
+		if (bestLevel == secondLevel && best > o.ratio * second) continue;
+		matches[bestIdx] = c.id;
+		++added;
+	}
+	return added;
+}
+
+std::vector<std::pair<int, int>> matchBruteForce(
+	const FrameFeatures& a, const FrameFeatures& b, const MatcherOptions& o, float ratio)
+{
+	std::vector<std::pair<int, int>> out;
+	if (a.descriptors.empty() || b.descriptors.empty()) return out;
+	const int norm = a.isBinary() ? cv::NORM_HAMMING : cv::NORM_L2;
+	cv::BFMatcher bf(norm, false);
+	std::vector<std::vector<cv::DMatch>> ab;
+	std::vector<cv::DMatch> ba;
+	bf.knnMatch(a.descriptors, b.descriptors, ab, 2);
+	bf.match(b.descriptors, a.descriptors, ba);
+	const float maxDist = o.maxDistance(a.isBinary());
+	for (const auto& m : ab)
+	{
+		if (m.empty() || m[0].distance > maxDist) continue;
+		if (m.size() > 1 && m[0].distance > ratio * m[1].distance) continue;
+		if (ba[m[0].trainIdx].trainIdx != m[0].queryIdx) continue;  // mutual best
+		out.emplace_back(m[0].queryIdx, m[0].trainIdx);
+	}
+	return out;
+}
+
+}  // namespace keygrid::sfm

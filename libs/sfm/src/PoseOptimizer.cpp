@@ -1,0 +1,129 @@
+#include <keygrid/sfm/PoseOptimizer.h>
+#include <mrpt/math/CMatrixFixed.h>
+
+#include <ceres/ceres.h>
+#include <cmath>
+#include <memory>
+#include <stdexcept>
+
+namespace keygrid::sfm
+{
+void toCeres(const mrpt::poses::CPose3D& T_world_cam, double q[4], double t[3])
+{
+	const auto T_cam_world = -T_world_cam;
+	const auto R = T_cam_world.getRotationMatrix();
+	Eigen::Matrix3d Re;
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++) Re(i, j) = R(i, j);
+	Eigen::Quaterniond qe(Re);
+	qe.normalize();
+	q[0] = qe.x();
+	q[1] = qe.y();
+	q[2] = qe.z();
+	q[3] = qe.w();
+	t[0] = T_cam_world.x();
+	t[1] = T_cam_world.y();
+	t[2] = T_cam_world.z();
+}
+
+mrpt::poses::CPose3D fromCeres(const double q[4], const double t[3])
+{
+	const Eigen::Quaterniond qe(q[3], q[0], q[1], q[2]);
+	const Eigen::Matrix3d Re = qe.normalized().toRotationMatrix();
+	mrpt::math::CMatrixDouble33 R;
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < 3; j++) R(i, j) = Re(i, j);
+	mrpt::math::CVectorFixedDouble<3> tv;
+	tv[0] = t[0];
+	tv[1] = t[1];
+	tv[2] = t[2];
+	const mrpt::poses::CPose3D T_cam_world = mrpt::poses::CPose3D::FromRotationAndTranslation(R, tv);
+	return -T_cam_world;
+}
+
+PoseOptimizerResult optimizePose(
+	mrpt::poses::CPose3D& T_world_cam, const std::vector<PoseObservation>& obs,
+	const PinholeIntrinsics& K, const PoseOptimizerOptions& o)
+{
+	if (obs.empty()) throw std::invalid_argument("optimizePose: no observations");
+	double q[4], t[3];
+	toCeres(T_world_cam, q, t);
+	const std::size_t n = obs.size();
+	PoseOptimizerResult res;
+	res.inlier.assign(n, 1);
+
+	auto useDepth = [&](const PoseObservation& ob) { return ob.depth > 0 && ob.depth < o.maxDepthForRgbd; };
+	// Squared residual of one observation at the current estimate (no robust loss).
+	auto chi2 = [&](const PoseObservation& ob) {
+		double u, v, ur;
+		const double p[3] = {ob.p_world.x(), ob.p_world.y(), ob.p_world.z()};
+		if (!projectRgbd(q, t, p, K, o.bf, u, v, ur)) return 1e30;
+		const double du = (ob.uv.x() - u) * ob.invSigma, dv = (ob.uv.y() - v) * ob.invSigma;
+		double e = du * du + dv * dv;
+		if (useDepth(ob))
+		{
+			const double dr = ((ob.uv.x() - o.bf / ob.depth) - ur) * ob.invSigma;
+			e += dr * dr;
+		}
+		return e;
+	};
+
+	ceres::Solver::Options so;
+	so.linear_solver_type = ceres::DENSE_QR;
+	so.max_num_iterations = o.iterationsPerRound;
+	so.num_threads = 1;
+	so.logging_type = ceres::SILENT;
+	so.minimizer_progress_to_stdout = false;
+
+	for (int round = 0; round < o.rounds; round++)
+	{
+		ceres::Problem::Options po;
+		po.manifold_ownership = ceres::TAKE_OWNERSHIP;
+		ceres::Problem problem(po);
+		problem.AddParameterBlock(q, 4, new ceres::EigenQuaternionManifold());
+		problem.AddParameterBlock(t, 3);
+		int used = 0;
+		for (std::size_t i = 0; i < n; i++)
+		{
+			if (!res.inlier[i]) continue;
+			const auto& ob = obs[i];
+			// Huber only in the first rounds: later rounds see inliers only (as ORB-SLAM2).
+			ceres::LossFunction* loss = nullptr;
+			if (round < o.rounds - 1) loss = new ceres::HuberLoss(std::sqrt(useDepth(ob) ? o.chi2Rgbd : o.chi2Mono));
+			if (useDepth(ob))
+				problem.AddResidualBlock(
+					new ceres::AutoDiffCostFunction<FixedPointCost<RgbdReprojectionCost>, 3, 4, 3>(
+						new FixedPointCost<RgbdReprojectionCost>(
+							RgbdReprojectionCost(ob.uv, ob.depth, o.bf, ob.invSigma, K), ob.p_world)),
+					loss, q, t);
+			else
+				problem.AddResidualBlock(
+					new ceres::AutoDiffCostFunction<FixedPointCost<MonoReprojectionCost>, 2, 4, 3>(
+						new FixedPointCost<MonoReprojectionCost>(MonoReprojectionCost(ob.uv, ob.invSigma, K), ob.p_world)),
+					loss, q, t);
+			++used;
+		}
+		if (used < 3) break;
+		ceres::Solver::Summary summary;
+		ceres::Solve(so, &problem, &summary);
+		// Re-classify every observation (outliers may come back) at the new estimate.
+		for (std::size_t i = 0; i < n; i++)
+			res.inlier[i] = chi2(obs[i]) <= (useDepth(obs[i]) ? o.chi2Rgbd : o.chi2Mono);
+	}
+	res.inliers = 0;
+	double sq = 0;
+	for (std::size_t i = 0; i < n; i++)
+	{
+		if (!res.inlier[i]) continue;
+		res.inliers++;
+		double u, v, ur;
+		const double p[3] = {obs[i].p_world.x(), obs[i].p_world.y(), obs[i].p_world.z()};
+		projectRgbd(q, t, p, K, o.bf, u, v, ur);
+		sq += (obs[i].uv - Eigen::Vector2d(u, v)).squaredNorm();
+	}
+	res.rmsPixels = res.inliers ? std::sqrt(sq / res.inliers) : 0.0;
+	T_world_cam = fromCeres(q, t);
+	return res;
+}
+
+}  // namespace keygrid::sfm

@@ -1,0 +1,340 @@
+#include <keygrid/sfm/Tracker.h>
+
+#include <algorithm>
+#include <numeric>
+#include <set>
+
+namespace keygrid::sfm
+{
+Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float d)
+{
+	return {(u - K.cx) / K.fx * d, (v - K.cy) / K.fy * d, static_cast<double>(d)};
+}
+
+PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& c) { return {c.fx, c.fy, c.cx, c.cy}; }
+
+Tracker::Tracker(SparseMap& map, const TrackerOptions& opts) : m_map(map), m_opts(opts) {}
+
+TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
+{
+	TrackedFrame out;
+	out.index = frame.index;
+	out.timestamp = frame.timestamp;
+	Current cur;
+	cur.frame = &frame;
+	cur.features = std::move(features);
+	cur.matches.assign(cur.features.size(), kNoLandmark);
+	m_K = intrinsicsOf(cur.features.camera);
+
+	if (m_state == TrackingState::NotInitialized)
+	{
+		if (!initialize(cur, out))
+		{
+			out.method = "lost";
+			out.T_world_cam = m_lastPose;
+		}
+		return out;
+	}
+
+	bool ok = false;
+	if (m_state == TrackingState::Ok)
+	{
+		cur.T_world_cam = m_velocity ? m_lastPose + *m_velocity : m_lastPose;
+		ok = trackByPrediction(cur);
+		out.method = "prediction";
+		if (!ok)
+		{
+			cur.matches.assign(cur.features.size(), kNoLandmark);
+			cur.T_world_cam = m_lastPose;
+			ok = trackByPnp(cur, m_refKf, m_opts.minInliers);
+			out.method = "pnp";
+		}
+	}
+	else
+	{
+		ok = relocalize(cur);
+		out.method = "relocalization";
+	}
+	if (ok)
+	{
+		updateLocalKeyFrames(cur);
+		cur.inliers = trackLocalMap(cur, m_opts.radiusLocalMap);
+		ok = cur.inliers >= m_opts.minInliers;
+	}
+
+	out.matches = static_cast<int>(std::count_if(cur.matches.begin(), cur.matches.end(), [](LandmarkId l) { return l != kNoLandmark; }));
+	out.inliers = cur.inliers;
+	if (ok)
+	{
+		m_velocity = cur.T_world_cam - m_lastPose;  // inv(last) * cur
+		m_lastPose = cur.T_world_cam;
+		m_state = TrackingState::Ok;
+		m_framesLost = 0;
+		m_lastInliers.clear();
+		for (LandmarkId l : cur.matches)
+			if (l != kNoLandmark) m_lastInliers.push_back(l);
+		if (needKeyFrame(cur))
+		{
+			out.keyframe = createKeyFrame(cur);
+			out.newKeyFrame = true;
+		}
+	}
+	else
+	{
+		m_state = TrackingState::Lost;
+		m_velocity.reset();
+		++m_framesLost;
+		out.method = "lost";
+		cur.T_world_cam = m_lastPose;  // best guess until relocalized
+	}
+	out.tracked = ok;
+	out.T_world_cam = cur.T_world_cam;
+	if (m_map.hasKeyFrame(m_refKf))
+	{
+		out.reference = m_refKf;
+		out.T_ref_cam = cur.T_world_cam - m_map.keyframe(m_refKf).T_world_cam;
+		out.hasReference = true;
+	}
+	return out;
+}
+
+bool Tracker::initialize(Current& cur, TrackedFrame& out)
+{
+	const int withDepth = static_cast<int>(std::count_if(cur.features.depth.begin(), cur.features.depth.end(), [](float d) { return d > 0; }));
+	if (withDepth < m_opts.minInitFeatures) return false;
+	cur.T_world_cam = mrpt::poses::CPose3D();  // the first keyframe defines the world frame
+	KeyFrame kf;
+	kf.frameIndex = cur.frame->index;
+	kf.timestamp = cur.frame->timestamp;
+	kf.T_world_cam = cur.T_world_cam;
+	kf.features = cur.features;
+	kf.depth = cur.frame->depth;
+	const KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;
+	const auto& f = m_map.keyframe(id).features;
+	for (std::size_t i = 0; i < f.size(); i++)
+		if (f.depth[i] > 0)
+			m_map.addLandmark(backProject(m_K, f.undistorted[i].x, f.undistorted[i].y, f.depth[i]), id, static_cast<int>(i));
+	m_refKf = id;
+	m_lastKfFrame = cur.frame->index;
+	m_localKfs = {id};
+	m_lastPose = cur.T_world_cam;
+	m_velocity.reset();
+	m_state = TrackingState::Ok;
+	out.tracked = true;
+	out.method = "init";
+	out.inliers = out.matches = static_cast<int>(m_map.numLandmarks());
+	out.newKeyFrame = true;
+	out.keyframe = id;
+	out.T_world_cam = cur.T_world_cam;
+	out.reference = id;
+	out.hasReference = true;
+	m_lastInliers.clear();
+	return true;
+}
+
+std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(const Current& cur, bool countVisible)
+{
+	std::set<LandmarkId> already(cur.matches.begin(), cur.matches.end());
+	std::set<LandmarkId> seen;
+	std::vector<ProjectedLandmark> out;
+	const auto T_cam_world = -cur.T_world_cam;
+	const Eigen::Vector3d center = translationOf(cur.T_world_cam);
+	for (KeyFrameId kfId : m_localKfs)
+	{
+		if (!m_map.hasKeyFrame(kfId)) continue;
+		for (LandmarkId id : m_map.keyframe(kfId).landmarks)
+		{
+			if (id == kNoLandmark || already.count(id) || !seen.insert(id).second) continue;
+			if (!m_map.hasLandmark(id)) continue;
+			auto& lm = m_map.landmark(id);
+			ProjectedLandmark p;
+			if (!projectLandmark(lm, T_cam_world, center, m_K, cur.features, m_opts.matcher, p)) continue;
+			if (countVisible) lm.visibleCount++;
+			out.push_back(p);
+		}
+	}
+	return out;
+}
+
+int Tracker::refinePose(Current& cur)
+{
+	std::vector<PoseObservation> obs;
+	std::vector<int> kpOf;
+	for (std::size_t i = 0; i < cur.matches.size(); i++)
+	{
+		if (cur.matches[i] == kNoLandmark || !m_map.hasLandmark(cur.matches[i])) continue;
+		const auto& f = cur.features;
+		PoseObservation o;
+		o.p_world = m_map.landmark(cur.matches[i]).p_world;
+		o.uv = {f.undistorted[i].x, f.undistorted[i].y};
+		o.depth = f.depth[i];
+		o.invSigma = 1.0 / f.levelScale[f.keypoints[i].octave];
+		obs.push_back(o);
+		kpOf.push_back(static_cast<int>(i));
+	}
+	if (obs.size() < 6) return 0;
+	const auto r = optimizePose(cur.T_world_cam, obs, m_K, m_opts.pose);
+	for (std::size_t k = 0; k < obs.size(); k++)
+		if (!r.inlier[k]) cur.matches[kpOf[k]] = kNoLandmark;
+	return r.inliers;
+}
+
+bool Tracker::trackByPrediction(Current& cur)
+{
+	if (m_localKfs.empty()) m_localKfs = {m_refKf};
+	auto cands = projectLocalLandmarks(cur, false);
+	int n = searchByProjection(cur.features, cands, m_opts.radiusPrediction, m_opts.matcher, cur.matches);
+	if (n < m_opts.minMatchesPrediction)
+	{
+		cur.matches.assign(cur.features.size(), kNoLandmark);
+		n = searchByProjection(cur.features, cands, 2.5f * m_opts.radiusPrediction, m_opts.matcher, cur.matches);
+	}
+	if (n < m_opts.minMatchesPrediction) return false;
+	return refinePose(cur) >= m_opts.minInliers / 2;
+}
+
+bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minInliers)
+{
+	if (!m_map.hasKeyFrame(kfId)) return false;
+	const auto& kf = m_map.keyframe(kfId);
+	const auto pairs = matchBruteForce(cur.features, kf.features, m_opts.matcher);
+	std::vector<Eigen::Vector3d> pw;
+	std::vector<Eigen::Vector2d> px;
+	std::vector<std::pair<int, LandmarkId>> link;
+	for (const auto& [i, j] : pairs)
+	{
+		const LandmarkId lm = kf.landmarks[j];
+		if (lm == kNoLandmark || !m_map.hasLandmark(lm)) continue;
+		pw.push_back(m_map.landmark(lm).p_world);
+		px.emplace_back(cur.features.undistorted[i].x, cur.features.undistorted[i].y);
+		link.emplace_back(i, lm);
+	}
+	const auto res = solvePnpRansac(pw, px, m_K, m_opts.pnp);
+	if (!res.ok) return false;
+	cur.T_world_cam = res.T_world_cam;
+	cur.matches.assign(cur.features.size(), kNoLandmark);
+	for (int k : res.inliers) cur.matches[link[k].first] = link[k].second;
+	const int inl = refinePose(cur);
+	if (inl < minInliers / 2) return false;
+	m_localKfs = {kfId};
+	for (KeyFrameId n : m_map.bestCovisibles(kfId, 10)) m_localKfs.push_back(n);
+	return true;
+}
+
+bool Tracker::relocalize(Current& cur)
+{
+	// Newest keyframes first: after a short loss the camera is usually near where it was.
+	std::vector<KeyFrameId> ids;
+	for (auto it = m_map.keyframes().rbegin(); it != m_map.keyframes().rend() && static_cast<int>(ids.size()) < m_opts.relocalizationCandidates; ++it)
+		ids.push_back(it->first);
+	for (KeyFrameId id : ids)
+	{
+		cur.matches.assign(cur.features.size(), kNoLandmark);
+		cur.T_world_cam = m_map.keyframe(id).T_world_cam;
+		if (trackByPnp(cur, id, m_opts.minInliers * 2))
+		{
+			m_refKf = id;
+			return true;
+		}
+	}
+	return false;
+}
+
+void Tracker::updateLocalKeyFrames(const Current& cur)
+{
+	std::map<KeyFrameId, int> counts;
+	for (LandmarkId l : cur.matches)
+	{
+		if (l == kNoLandmark || !m_map.hasLandmark(l)) continue;
+		for (const auto& [kf, kp] : m_map.landmark(l).observations) counts[kf]++;
+	}
+	if (counts.empty()) return;
+	std::vector<std::pair<int, KeyFrameId>> v;
+	for (const auto& [kf, c] : counts) v.emplace_back(-c, kf);
+	std::sort(v.begin(), v.end());
+	m_localKfs.clear();
+	std::set<KeyFrameId> in;
+	for (const auto& [c, kf] : v)
+	{
+		if (static_cast<int>(m_localKfs.size()) >= m_opts.localKeyFrames) break;
+		if (in.insert(kf).second) m_localKfs.push_back(kf);
+	}
+	// Neighbours of the strongest ones widen the local map.
+	const std::size_t base = m_localKfs.size();
+	for (std::size_t i = 0; i < base && static_cast<int>(m_localKfs.size()) < m_opts.localKeyFrames; i++)
+		for (KeyFrameId n : m_map.bestCovisibles(m_localKfs[i], 5))
+			if (static_cast<int>(m_localKfs.size()) < m_opts.localKeyFrames && in.insert(n).second) m_localKfs.push_back(n);
+	// The reference keyframe: the one sharing most landmarks.
+	m_refKf = v.front().second;
+}
+
+int Tracker::trackLocalMap(Current& cur, float radius)
+{
+	auto cands = projectLocalLandmarks(cur, true);
+	searchByProjection(cur.features, cands, radius, m_opts.matcher, cur.matches);
+	const int inl = refinePose(cur);
+	for (LandmarkId l : cur.matches)
+		if (l != kNoLandmark && m_map.hasLandmark(l)) m_map.landmark(l).foundCount++;
+	return inl;
+}
+
+bool Tracker::needKeyFrame(const Current& cur) const
+{
+	const int sinceLast = static_cast<int>(cur.frame->index - m_lastKfFrame);
+	const int minObs = m_map.numKeyFrames() > 2 ? 3 : 2;
+	const int refMatches = m_map.hasKeyFrame(m_refKf) ? m_map.keyframe(m_refKf).trackedLandmarks(minObs, &m_map) : 0;
+	int trackedClose = 0, newClose = 0;
+	for (std::size_t i = 0; i < cur.features.size(); i++)
+	{
+		const float d = cur.features.depth[i];
+		if (d <= 0 || d > m_opts.closeDepth) continue;
+		(cur.matches[i] != kNoLandmark ? trackedClose : newClose)++;
+	}
+	const bool needClose = trackedClose < m_opts.minTrackedClose && newClose > m_opts.minNewClose;
+	const double ratio = m_map.numKeyFrames() < 2 ? 0.4 : m_opts.keyFrameTrackedRatio;
+	const bool timeout = sinceLast >= m_opts.maxFramesBetweenKeyFrames;
+	const bool weak = cur.inliers < ratio * refMatches || needClose;
+	return (timeout || weak) && cur.inliers > 15;
+}
+
+KeyFrameId Tracker::createKeyFrame(const Current& cur)
+{
+	KeyFrame kf;
+	kf.frameIndex = cur.frame->index;
+	kf.timestamp = cur.frame->timestamp;
+	kf.T_world_cam = cur.T_world_cam;
+	kf.features = cur.features;
+	kf.depth = cur.frame->depth;
+	kf.parent = m_refKf;
+	kf.hasParent = m_map.hasKeyFrame(m_refKf);
+	const KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;
+	auto& k = m_map.keyframe(id);
+	for (std::size_t i = 0; i < cur.matches.size(); i++)
+		if (cur.matches[i] != kNoLandmark && m_map.hasLandmark(cur.matches[i]))
+			m_map.addObservation(cur.matches[i], id, static_cast<int>(i));
+	// New landmarks from depth: every close untracked keypoint, then farther ones until the
+	// minimum count is reached (nearest first).
+	std::vector<std::pair<float, int>> byDepth;
+	for (std::size_t i = 0; i < k.features.size(); i++)
+		if (k.landmarks[i] == kNoLandmark && k.features.depth[i] > 0) byDepth.emplace_back(k.features.depth[i], static_cast<int>(i));
+	std::sort(byDepth.begin(), byDepth.end());
+	int created = 0;
+	for (const auto& [d, i] : byDepth)
+	{
+		if (d > m_opts.closeDepth && created >= m_opts.minNewLandmarksPerKeyFrame) break;
+		const Eigen::Vector3d p_cam = backProject(m_K, k.features.undistorted[i].x, k.features.undistorted[i].y, d);
+		double x, y, z;
+		k.T_world_cam.composePoint(p_cam.x(), p_cam.y(), p_cam.z(), x, y, z);
+		m_map.addLandmark({x, y, z}, id, i);
+		++created;
+	}
+	for (LandmarkId l : cur.matches)
+		if (l != kNoLandmark && m_map.hasLandmark(l)) m_map.updateLandmarkStats(l);
+	m_map.updateCovisibility(id);
+	m_refKf = id;
+	m_lastKfFrame = cur.frame->index;
+	if (std::find(m_localKfs.begin(), m_localKfs.end(), id) == m_localKfs.end()) m_localKfs.insert(m_localKfs.begin(), id);
+	return id;
+}
+
+}  // namespace keygrid::sfm

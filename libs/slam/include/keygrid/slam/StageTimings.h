@@ -1,0 +1,31 @@
+#pragma once
+/** \file StageTimings.h
+ * Per-stage durations of the pipeline (load, extract, track, mapping, ...), summarised as
+ * median and 95th percentile for report.json.
+ */
+#include <map>
+#include <string>
+#include <vector>
+
+namespace keygrid::slam
+{
+class StageTimings
+{
+   public:
+	void add(const std::string& stage, double seconds) { m_samples[stage].push_back(seconds); }
+
+	struct Summary
+	{
+		std::size_t count{0};
+		double total{0}, mean{0}, median{0}, p95{0}, max{0};  //!< seconds
+	};
+	Summary summary(const std::string& stage) const;
+	std::vector<std::string> stages() const;
+	/** JSON object: {"stage": {"count":..,"median_ms":..,"p95_ms":..,"mean_ms":..,"max_ms":..,"total_s":..}, ...} */
+	std::string toJson(int indent = 2) const;
+
+   private:
+	std::map<std::string, std::vector<double>> m_samples;
+};
+
+}  // namespace keygrid::slam

@@ -1,0 +1,61 @@
+#pragma once
+/** \file System.h
+ * The SLAM pipeline for one sequence: feature extraction, tracking and local mapping over a
+ * shared sparse map, with the per-frame record from which the final trajectory is built.
+ *
+ * Sequential use: process(frame) for each frame (deterministic). Pipelined use: extract()
+ * may run on another thread (it touches no shared state), then processExtracted() in order.
+ */
+#include <keygrid/core/TumTrajectory.h>
+#include <keygrid/sfm/LocalMapper.h>
+#include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/SlamConfig.h>
+#include <keygrid/slam/StageTimings.h>
+
+#include <memory>
+#include <vector>
+
+namespace keygrid::slam
+{
+struct SystemStats
+{
+	std::size_t frames{0}, tracked{0}, lost{0}, relocalizations{0}, pnpFallbacks{0};
+	std::size_t keyframesCreated{0}, keyframesCulled{0}, landmarksCulled{0}, landmarksFused{0};
+};
+
+class System
+{
+   public:
+	explicit System(const SlamConfig& cfg);
+
+	/** Features of a frame (thread-compatible: no shared state touched). */
+	sfm::FrameFeatures extract(const core::Frame& frame) const;
+	/** Tracks (and, on a new keyframe, maps) a frame whose features are given. */
+	const sfm::TrackedFrame& processExtracted(const core::Frame& frame, sfm::FrameFeatures features);
+	/** extract + processExtracted. */
+	const sfm::TrackedFrame& process(const core::Frame& frame);
+
+	/** Every processed frame's pose, re-anchored on its reference keyframe's final pose. */
+	core::Trajectory trajectory() const;
+	/** Poses of the keyframes in the map. */
+	core::Trajectory keyframeTrajectory() const;
+
+	const sfm::SparseMap& map() const { return m_map; }
+	const std::vector<sfm::TrackedFrame>& frames() const { return m_frames; }
+	const SystemStats& stats() const { return m_stats; }
+	StageTimings& timings() { return m_timings; }
+	const StageTimings& timings() const { return m_timings; }
+	const SlamConfig& config() const { return m_cfg; }
+
+   private:
+	SlamConfig m_cfg;
+	sfm::FeatureExtractor m_extractor;
+	sfm::SparseMap m_map;
+	sfm::Tracker m_tracker;
+	sfm::LocalMapper m_mapper;
+	std::vector<sfm::TrackedFrame> m_frames;
+	SystemStats m_stats;
+	StageTimings m_timings;
+};
+
+}  // namespace keygrid::slam

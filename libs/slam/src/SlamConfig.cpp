@@ -1,0 +1,47 @@
+#include <keygrid/slam/SlamConfig.h>
+#include <mrpt/config/CConfigFile.h>
+#include <mrpt/system/filesystem.h>
+
+#include <stdexcept>
+
+namespace keygrid::slam
+{
+void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
+{
+	mode = c.read_string("slam", "mode", mode);
+	camera = c.read_string("slam", "camera", camera);
+	if (mode != "sequential" && mode != "threaded")
+		throw std::invalid_argument("[slam] mode = '" + mode + "' (expected sequential or threaded)");
+	features.loadFromConfigFile(c, "features");
+	tracker.loadFromConfigFile(c, "tracker");
+	mapping.loadFromConfigFile(c, "mapping");
+	// The depth residual model is shared by tracking and bundle adjustment.
+	mapping.ba.bf = tracker.pose.bf;
+}
+
+void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
+{
+	c.write("slam", "mode", mode, 30, 40, "sequential | threaded");
+	c.write("slam", "camera", camera, 30, 40, "preset (fr1 fr2 fr3 icl kinect) or INI; empty: guess");
+	features.saveToConfigFile(c, "features");
+	tracker.saveToConfigFile(c, "tracker");
+	mapping.saveToConfigFile(c, "mapping");
+}
+
+SlamConfig SlamConfig::FromFile(const std::string& path)
+{
+	if (!mrpt::system::fileExists(path)) throw std::invalid_argument("config file '" + path + "' does not exist");
+	mrpt::config::CConfigFile cfg(path);
+	SlamConfig c;
+	try
+	{
+		c.loadFromConfigFile(cfg);
+	}
+	catch (const std::exception& e)
+	{
+		throw std::invalid_argument(path + ": " + e.what());
+	}
+	return c;
+}
+
+}  // namespace keygrid::slam
