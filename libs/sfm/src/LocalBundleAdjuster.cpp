@@ -29,25 +29,44 @@ void BundleAdjusterOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, c
 BundleAdjusterReport localBundleAdjustment(
 	SparseMap& map, KeyFrameId kfId, const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
 {
-	BundleAdjusterReport rep;
 	// --- Window: the keyframe and its best covisibles; landmarks they see; fixed observers.
 	std::vector<KeyFrameId> local = {kfId};
 	for (KeyFrameId id : map.bestCovisibles(kfId, static_cast<std::size_t>(o.windowSize))) local.push_back(id);
 	std::set<KeyFrameId> localSet(local.begin(), local.end());
+	std::map<KeyFrameId, int> fixedCount;
 	std::set<LandmarkId> lms;
 	for (KeyFrameId id : local)
 		for (LandmarkId lm : map.keyframe(id).landmarks)
-			if (lm != kNoLandmark && map.hasLandmark(lm)) lms.insert(lm);
-	std::map<KeyFrameId, int> fixedCount;
-	for (LandmarkId lm : lms)
-		for (const auto& [kf, kp] : map.landmark(lm).observations)
-			if (!localSet.count(kf)) fixedCount[kf]++;
+			if (lm != kNoLandmark && map.hasLandmark(lm) && lms.insert(lm).second)
+				for (const auto& [kf, kp] : map.landmark(lm).observations)
+					if (!localSet.count(kf)) fixedCount[kf]++;
 	std::vector<std::pair<int, KeyFrameId>> fixedSorted;
 	for (const auto& [kf, c] : fixedCount) fixedSorted.emplace_back(-c, kf);
 	std::sort(fixedSorted.begin(), fixedSorted.end());
 	std::set<KeyFrameId> fixedSet;
 	for (std::size_t i = 0; i < fixedSorted.size() && static_cast<int>(i) < o.maxFixedKeyFrames; i++)
 		fixedSet.insert(fixedSorted[i].second);
+	return bundleAdjust(map, local, fixedSet, K, o);
+}
+
+BundleAdjusterReport globalBundleAdjustment(
+	SparseMap& map, const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
+{
+	std::vector<KeyFrameId> all;
+	for (const auto& [id, kf] : map.keyframes()) all.push_back(id);
+	return bundleAdjust(map, all, {}, K, o);
+}
+
+BundleAdjusterReport bundleAdjust(
+	SparseMap& map, const std::vector<KeyFrameId>& local, const std::set<KeyFrameId>& fixedSet,
+	const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
+{
+	BundleAdjusterReport rep;
+	if (local.empty()) return rep;
+	std::set<LandmarkId> lms;
+	for (KeyFrameId id : local)
+		for (LandmarkId lm : map.keyframe(id).landmarks)
+			if (lm != kNoLandmark && map.hasLandmark(lm)) lms.insert(lm);
 
 	// --- Parameter blocks.
 	std::map<KeyFrameId, std::array<double, 7>> poses;  // q(x,y,z,w), t of T_cam_world

@@ -40,8 +40,20 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 	if (m_state == TrackingState::Ok)
 	{
 		cur.T_world_cam = m_velocity ? m_lastPose + *m_velocity : m_lastPose;
-		ok = trackByPrediction(cur);
-		out.method = "prediction";
+		// Without a motion prior (right after initialisation or relocalization) the camera may
+		// have moved tens of pixels: match descriptors against the reference keyframe first.
+		if (!m_velocity)
+		{
+			ok = trackByPnp(cur, m_refKf, m_opts.minInliers);
+			out.method = "pnp";
+		}
+		if (!ok)
+		{
+			cur.matches.assign(cur.features.size(), kNoLandmark);
+			cur.T_world_cam = m_velocity ? m_lastPose + *m_velocity : m_lastPose;
+			ok = trackByPrediction(cur);
+			out.method = "prediction";
+		}
 		if (!ok)
 		{
 			cur.matches.assign(cur.features.size(), kNoLandmark);
@@ -71,8 +83,18 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		m_state = TrackingState::Ok;
 		m_framesLost = 0;
 		m_lastInliers.clear();
-		for (LandmarkId l : cur.matches)
-			if (l != kNoLandmark) m_lastInliers.push_back(l);
+		for (std::size_t i = 0; i < cur.matches.size(); i++)
+		{
+			const LandmarkId l = cur.matches[i];
+			if (l == kNoLandmark) continue;
+			m_lastInliers.push_back(l);
+			PoseObservation ob;
+			ob.uv = {cur.features.undistorted[i].x, cur.features.undistorted[i].y};
+			ob.depth = cur.features.depth[i];
+			ob.invSigma = 1.0 / cur.features.levelScale[cur.features.keypoints[i].octave];
+			out.observedLandmarks.push_back(l);
+			out.observations.push_back(ob);
+		}
 		if (needKeyFrame(cur))
 		{
 			out.keyframe = createKeyFrame(cur);
@@ -184,7 +206,8 @@ bool Tracker::trackByPrediction(Current& cur)
 	if (m_localKfs.empty()) m_localKfs = {m_refKf};
 	auto cands = projectLocalLandmarks(cur, false);
 	int n = searchByProjection(cur.features, cands, m_opts.radiusPrediction, m_opts.matcher, cur.matches);
-	if (n < m_opts.minMatchesPrediction)
+	// Few matches in the window: the motion changed; search wider before giving up.
+	if (n < 2 * m_opts.minMatchesPrediction)
 	{
 		cur.matches.assign(cur.features.size(), kNoLandmark);
 		n = searchByProjection(cur.features, cands, 2.5f * m_opts.radiusPrediction, m_opts.matcher, cur.matches);
@@ -270,6 +293,9 @@ void Tracker::updateLocalKeyFrames(const Current& cur)
 
 int Tracker::trackLocalMap(Current& cur, float radius)
 {
+	// Landmarks matched before this stage were in view too.
+	for (LandmarkId l : cur.matches)
+		if (l != kNoLandmark && m_map.hasLandmark(l)) m_map.landmark(l).visibleCount++;
 	auto cands = projectLocalLandmarks(cur, true);
 	searchByProjection(cur.features, cands, radius, m_opts.matcher, cur.matches);
 	const int inl = refinePose(cur);

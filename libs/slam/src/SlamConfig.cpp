@@ -15,6 +15,11 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	features.loadFromConfigFile(c, "features");
 	tracker.loadFromConfigFile(c, "tracker");
 	mapping.loadFromConfigFile(c, "mapping");
+	refinement.globalBundleAdjustment = c.read_bool("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment);
+	refinement.globalIterations = c.read_int("refinement", "global_iterations", refinement.globalIterations);
+	refinement.refineFrames = c.read_bool("refinement", "refine_frames", refinement.refineFrames);
+	if (refinement.globalIterations < 1)
+		throw std::invalid_argument("[refinement] global_iterations = " + std::to_string(refinement.globalIterations) + " (must be >= 1)");
 	// The depth residual model is shared by tracking and bundle adjustment.
 	mapping.ba.bf = tracker.pose.bf;
 }
@@ -22,10 +27,13 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 {
 	c.write("slam", "mode", mode, 30, 40, "sequential | threaded");
-	c.write("slam", "camera", camera, 30, 40, "preset (fr1 fr2 fr3 icl kinect) or INI; empty: guess");
+	c.write("slam", "camera", camera.empty() ? std::string("auto") : camera, 30, 40, "preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
 	features.saveToConfigFile(c, "features");
 	tracker.saveToConfigFile(c, "tracker");
 	mapping.saveToConfigFile(c, "mapping");
+	c.write("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment, 30, 40, "bundle-adjust everything after the last frame");
+	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "");
+	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame against the final map");
 }
 
 SlamConfig SlamConfig::FromFile(const std::string& path)

@@ -34,6 +34,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 {
 	auto t0 = std::chrono::steady_clock::now();
 	const sfm::PinholeIntrinsics K = sfm::intrinsicsOf(features.camera);
+	if (!m_K) m_K = K;
 	sfm::TrackedFrame tf = m_tracker.track(frame, std::move(features));
 	m_timings.add("track", secondsSince(t0));
 	if (tf.newKeyFrame)
@@ -45,8 +46,12 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		m_stats.keyframesCulled += rep.culledKeyFrames;
 		m_stats.landmarksCulled += rep.culledLandmarks;
 		m_stats.landmarksFused += rep.fusedLandmarks;
+		m_stats.sumBaKeyFrames += rep.ba.keyframes;
+		m_stats.sumBaObservations += rep.ba.observations;
+		m_stats.sumBaOutliers += rep.ba.outliersRemoved;
 	}
 	m_stats.frames++;
+	m_stats.sumInliers += tf.inliers;
 	if (tf.tracked) m_stats.tracked++;
 	else
 		m_stats.lost++;
@@ -56,12 +61,54 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	return m_frames.back();
 }
 
+void System::finish()
+{
+	if (m_finished || !m_K || m_map.numKeyFrames() == 0) return;
+	m_finished = true;
+	const auto t0 = std::chrono::steady_clock::now();
+	if (m_cfg.refinement.globalBundleAdjustment && m_map.numKeyFrames() > 1)
+	{
+		auto o = m_cfg.mapping.ba;
+		o.iterations = m_cfg.refinement.globalIterations;
+		sfm::globalBundleAdjustment(m_map, *m_K, o);
+	}
+	m_timings.add("global_bundle_adjustment", secondsSince(t0));
+	if (!m_cfg.refinement.refineFrames) return;
+	const auto t1 = std::chrono::steady_clock::now();
+	const auto base = trajectory();
+	m_refined.assign(m_frames.size(), std::nullopt);
+	for (std::size_t i = 0; i < m_frames.size(); i++)
+	{
+		const auto& f = m_frames[i];
+		if (!f.tracked) continue;
+		std::vector<sfm::PoseObservation> obs;
+		for (std::size_t k = 0; k < f.observations.size(); k++)
+		{
+			if (!m_map.hasLandmark(f.observedLandmarks[k])) continue;
+			auto ob = f.observations[k];
+			ob.p_world = m_map.landmark(f.observedLandmarks[k]).p_world;
+			obs.push_back(ob);
+		}
+		if (static_cast<int>(obs.size()) < m_cfg.tracker.minInliers) continue;
+		auto T = base[i].T_world_cam;
+		const auto r = sfm::optimizePose(T, obs, *m_K, m_cfg.tracker.pose);
+		if (r.inliers >= m_cfg.tracker.minInliers) m_refined[i] = T;
+	}
+	m_timings.add("frame_refinement", secondsSince(t1));
+}
+
 core::Trajectory System::trajectory() const
 {
 	core::Trajectory out;
 	out.reserve(m_frames.size());
-	for (const auto& f : m_frames)
+	for (std::size_t i = 0; i < m_frames.size(); i++)
 	{
+		const auto& f = m_frames[i];
+		if (i < m_refined.size() && m_refined[i])
+		{
+			out.push_back({f.timestamp, *m_refined[i]});
+			continue;
+		}
 		mrpt::poses::CPose3D T_world_ref;
 		if (f.hasReference && m_map.poseOf(f.reference, T_world_ref))
 			out.push_back({f.timestamp, T_world_ref + f.T_ref_cam});

@@ -1,12 +1,14 @@
 #include <keygrid/core/BoundedQueue.h>
 #include <keygrid/core/CommandLine.h>
 #include <keygrid/core/FrameSource.h>
+#include <keygrid/core/PrefetchingFrameSource.h>
 #include <keygrid/core/ProgressBar.h>
 #include <keygrid/eval/TrajectoryErrors.h>
 #include <keygrid/slam/AtomicFile.h>
 #include <keygrid/slam/System.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/SlamApp.h>
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/system/filesystem.h>
 
 #include <chrono>
@@ -64,8 +66,9 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (!mrpt::system::directoryExists(o.output) && !mrpt::system::createDirectory(o.output))
 		throw std::runtime_error("cannot create output folder '" + o.output + "'");
 	core::FrameSourceOptions so;
-	if (!cfg.camera.empty()) so.camera = core::RgbdCamera::FromPresetOrFile(cfg.camera);
-	auto source = core::openFrameSource(o.input, so);
+	if (!cfg.camera.empty() && cfg.camera != "auto") so.camera = core::RgbdCamera::FromPresetOrFile(cfg.camera);
+	// Decoding runs ahead on its own thread in both modes; frames keep their order.
+	auto source = std::make_unique<core::PrefetchingFrameSource>(core::openFrameSource(o.input, so), 4);
 	std::optional<core::Trajectory> gt;
 	if (!o.groundTruth.empty()) gt = core::readTumTrajectory(o.groundTruth);
 
@@ -93,7 +96,8 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			{
 				auto t0 = Clock::now();
 				if (!source->next(f)) break;
-				sys.timings().add("load", since(t0));
+				sys.timings().add("load_wait", since(t0));
+				sys.timings().add("load", source->lastLoadSeconds());
 				t0 = Clock::now();
 				report(sys.process(f));
 				sys.timings().add("frame_total", since(t0));
@@ -101,8 +105,8 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		}
 		else
 		{
-			// Threaded: loading + feature extraction on a producer thread, tracking and mapping
-			// in order on this one; the two meet in a typed bounded queue.
+			// Threaded: decoding (prefetch thread) -> feature extraction (producer thread) ->
+			// tracking and mapping in order on this thread, joined by typed bounded queues.
 			core::BoundedQueue<Extracted> queue(4);
 			std::string producerError;
 			std::thread producer([&] {
@@ -111,10 +115,9 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 					for (std::size_t n = 0; !limitReached(n); n++)
 					{
 						Extracted e;
-						auto t0 = Clock::now();
 						if (!source->next(e.frame)) break;
-						e.loadSeconds = since(t0);
-						t0 = Clock::now();
+						e.loadSeconds = source->lastLoadSeconds();
+						const auto t0 = Clock::now();
 						e.features = sys.extract(e.frame);
 						e.extractSeconds = since(t0);
 						if (!queue.push(std::move(e))) break;
@@ -143,11 +146,31 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		// Keep what was processed: outputs are still written below.
 		res.error = e.what();
 	}
-	const double wall = since(tStart);
 	bar.finish();
+	sys.finish();
+	const double wall = since(tStart);
 
 	const auto traj = sys.trajectory();
 	writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, "keygrid-slam trajectory, every frame"));
+	{
+		// As tracked, before later map refinement (diagnostics: trajectory.txt is the final one).
+		core::Trajectory raw;
+		for (const auto& f : sys.frames()) raw.push_back({f.timestamp, f.T_world_cam});
+		writeFileAtomically(o.output + "/trajectory_online.txt", trajectoryText(raw, "keygrid-slam online poses (as tracked)"));
+	}
+	{
+		std::ostringstream csv;
+		csv << "index,timestamp,tracked,method,matches,inliers,new_keyframe,reference_keyframe\n";
+		for (const auto& f : sys.frames())
+		{
+			char line[160];
+			std::snprintf(line, sizeof(line), "%zu,%.6f,%d,%s,%d,%d,%d,%lld\n", f.index, f.timestamp, f.tracked ? 1 : 0,
+						  f.method.c_str(), f.matches, f.inliers, f.newKeyFrame ? 1 : 0,
+						  f.hasReference ? static_cast<long long>(f.reference) : -1LL);
+			csv << line;
+		}
+		writeFileAtomically(o.output + "/frames.csv", csv.str());
+	}
 	writeFileAtomically(o.output + "/keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
 
 	res.frames = sys.stats().frames;
@@ -178,7 +201,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "  \"lost\": " << st.lost << ",\n";
 	js << "  \"relocalizations\": " << st.relocalizations << ",\n";
 	js << "  \"pnp_fallbacks\": " << st.pnpFallbacks << ",\n";
-	js << "  \"skipped_input_entries\": " << source->skippedCount() << ",\n";
+	js << "  \"skipped_input_entries\": " << source->innerSkipped() << ",\n";
 	js << "  \"keyframes\": " << sys.map().numKeyFrames() << ",\n";
 	js << "  \"keyframes_created\": " << st.keyframesCreated << ",\n";
 	js << "  \"keyframes_culled\": " << st.keyframesCulled << ",\n";
@@ -186,6 +209,13 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "  \"landmarks_culled\": " << st.landmarksCulled << ",\n";
 	js << "  \"landmarks_fused\": " << st.landmarksFused << ",\n";
 	js << "  \"loop_closures\": [],\n";
+	{
+		char m[256];
+		const double kfs = std::max<std::size_t>(1, st.keyframesCreated);
+		std::snprintf(m, sizeof(m), "  \"mean_inliers\": %.1f,\n  \"mean_ba_keyframes\": %.1f,\n  \"mean_ba_observations\": %.1f,\n  \"mean_ba_outliers\": %.1f,\n",
+					  st.sumInliers / std::max<std::size_t>(1, st.frames), st.sumBaKeyFrames / kfs, st.sumBaObservations / kfs, st.sumBaOutliers / kfs);
+		js << m;
+	}
 	char b[64];
 	std::snprintf(b, sizeof(b), "%.3f", res.fps);
 	js << "  \"fps\": " << b << ",\n";
@@ -219,15 +249,26 @@ int SlamApp::run(int argc, const char* const* argv)
 			"RGB-D SLAM on a recorded sequence: keyframe-based ORB/SIFT tracking with local bundle\n"
 			"adjustment. Writes DIR/trajectory.txt (TUM, every frame), DIR/keyframes.txt and\n"
 			"DIR/report.json (frames, tracked, fps, per-stage timings, map sizes, and ATE with --gt).");
-		cl.option("config", "CFG.ini", "configuration (see config/*.ini)", true)
-			.option("input", "X.rawlog|TUM_DIR", "MRPT rawlog or TUM RGB-D folder", true)
-			.option("output", "DIR", "output folder (created if missing)", true)
+		cl.option("config", "CFG.ini", "configuration (see config/*.ini) (required)")
+			.option("input", "X.rawlog|TUM_DIR", "MRPT rawlog or TUM RGB-D folder (required)")
+			.option("output", "DIR", "output folder, created if missing (required)")
 			.option("gt", "GT.txt", "ground-truth trajectory (TUM) to report ATE against")
 			.option("mode", "sequential|threaded", "override [slam] mode")
 			.option("camera", "PRESET|FILE.ini", "override [slam] camera (TUM folders)")
 			.option("max-frames", "N", "stop after N frames", false, "0 (all)")
-			.flag("quiet", "no progress output");
+			.flag("quiet", "no progress output")
+			.flag("dump-config", "print the full effective configuration (defaults, or --config merged over them) and exit");
 		if (!cl.parse(argc, argv)) return 0;
+		if (cl.flagSet("dump-config"))
+		{
+			const SlamConfig c = cl.has("config") ? SlamConfig::FromFile(cl.get("config")) : SlamConfig();
+			mrpt::config::CConfigFileMemory mem;
+			c.saveToConfigFile(mem);
+			std::cout << "# keygrid-slam effective configuration\n" << mem.getContent();
+			return 0;
+		}
+		for (const char* req : {"config", "input", "output"})
+			if (!cl.has(req)) throw core::CommandLineError(std::string("missing --") + req);
 		SlamRunOptions o;
 		o.configPath = cl.get("config");
 		o.input = cl.get("input");

@@ -7,7 +7,9 @@
 #include <keygrid/sfm/PoseOptimizer.h>
 #include <keygrid/sfm/SparseMap.h>
 
+#include <set>
 #include <string>
+#include <vector>
 
 namespace mrpt::config
 {
@@ -46,5 +48,15 @@ struct BundleAdjusterReport
 /** Optimises the window around `kf` in place and removes outlier observations. */
 BundleAdjusterReport localBundleAdjustment(
 	SparseMap& map, KeyFrameId kf, const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);
+
+/** Optimises every keyframe and landmark (the first keyframe fixed) and removes outliers. */
+BundleAdjusterReport globalBundleAdjustment(
+	SparseMap& map, const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);
+
+/** The shared core: keyframes `local` move, `fixed` ones only anchor; all landmarks seen by
+ * `local` move. */
+BundleAdjusterReport bundleAdjust(
+	SparseMap& map, const std::vector<KeyFrameId>& local, const std::set<KeyFrameId>& fixed,
+	const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);
 
 }  // namespace keygrid::sfm

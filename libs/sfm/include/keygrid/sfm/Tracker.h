@@ -38,6 +38,10 @@ struct TrackedFrame
 	KeyFrameId reference{0};
 	mrpt::poses::CPose3D T_ref_cam;
 	bool hasReference{false};
+	/** Inlier observations of the frame (landmark ids and measurements; p_world is filled
+	 * when the pose is re-estimated against a refined map). */
+	std::vector<LandmarkId> observedLandmarks;
+	std::vector<PoseObservation> observations;
 };
 
 class Tracker

@@ -3,7 +3,7 @@
  * Everything one keygrid-slam run is configured with, loaded from one INI file.
  *
  * Sections: [slam] (mode, camera), [features], [tracker], [mapping] (local mapping and local
- * bundle adjustment). Keys absent from the file keep their documented defaults.
+ * bundle adjustment), [refinement] (final global bundle adjustment and frame re-estimation). Keys absent from the file keep their documented defaults.
  */
 #include <keygrid/sfm/FeatureExtractor.h>
 #include <keygrid/sfm/LocalMapper.h>
@@ -13,15 +13,28 @@
 
 namespace keygrid::slam
 {
+/** Batch refinement after the last frame (file inputs). */
+struct RefinementOptions
+{
+	/** Bundle-adjust all keyframes and landmarks at the end (Default: true) */
+	bool globalBundleAdjustment{true};
+	/** Iterations of the final global bundle adjustment (Default: 20) */
+	int globalIterations{20};
+	/** Re-estimate every frame's pose against the refined map (Default: true) */
+	bool refineFrames{true};
+};
+
 struct SlamConfig
 {
 	/** "sequential" (deterministic, default for files) or "threaded" (pipelined stages) */
 	std::string mode{"sequential"};
-	/** Camera for TUM folders: preset name or INI path; empty = guessed from the folder */
-	std::string camera;
+	/** Camera for TUM folders: preset name or INI path; "auto" (or empty) = camera.ini in the
+	 * folder, else guessed from the folder name (Default: auto) */
+	std::string camera{"auto"};
 	sfm::FeatureOptions features;
 	sfm::TrackerOptions tracker;
 	sfm::LocalMapperOptions mapping;
+	RefinementOptions refinement;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;

@@ -13,6 +13,7 @@
 #include <keygrid/slam/StageTimings.h>
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace keygrid::slam
@@ -21,6 +22,7 @@ struct SystemStats
 {
 	std::size_t frames{0}, tracked{0}, lost{0}, relocalizations{0}, pnpFallbacks{0};
 	std::size_t keyframesCreated{0}, keyframesCulled{0}, landmarksCulled{0}, landmarksFused{0};
+	double sumInliers{0}, sumBaKeyFrames{0}, sumBaObservations{0}, sumBaOutliers{0};
 };
 
 class System
@@ -35,7 +37,12 @@ class System
 	/** extract + processExtracted. */
 	const sfm::TrackedFrame& process(const core::Frame& frame);
 
-	/** Every processed frame's pose, re-anchored on its reference keyframe's final pose. */
+	/** After the last frame: global bundle adjustment and frame re-estimation, as configured
+	 * in [refinement]. Idempotent. */
+	void finish();
+
+	/** Every processed frame's pose: re-estimated against the final map when finish() did so,
+	 * else re-anchored on its reference keyframe's final pose. */
 	core::Trajectory trajectory() const;
 	/** Poses of the keyframes in the map. */
 	core::Trajectory keyframeTrajectory() const;
@@ -54,6 +61,9 @@ class System
 	sfm::Tracker m_tracker;
 	sfm::LocalMapper m_mapper;
 	std::vector<sfm::TrackedFrame> m_frames;
+	std::vector<std::optional<mrpt::poses::CPose3D>> m_refined;
+	std::optional<sfm::PinholeIntrinsics> m_K;
+	bool m_finished{false};
 	SystemStats m_stats;
 	StageTimings m_timings;
 };

@@ -1,0 +1,70 @@
+#include <keygrid/sfm/SparseMap.h>
+
+#include "TestData.h"
+
+using namespace keygrid::sfm;
+using mrpt::poses::CPose3D;
+
+namespace
+{
+KeyFrame makeKf(const CPose3D& pose, int nKps)
+{
+	KeyFrame kf;
+	kf.T_world_cam = pose;
+	kf.features.keypoints.resize(static_cast<std::size_t>(nKps));
+	kf.features.undistorted.resize(static_cast<std::size_t>(nKps));
+	kf.features.depth.assign(static_cast<std::size_t>(nKps), 1.f);
+	kf.features.descriptors = cv::Mat(nKps, 32, CV_8U, cv::Scalar(0));
+	kf.features.levelScale = {1.0, 1.2, 1.44};
+	return kf;
+}
+}  // namespace
+
+TEST(SparseMap, ObservationsCovisibilityAndErasure)
+{
+	SparseMap m;
+	const auto a = m.addKeyFrame(makeKf(CPose3D(), 40)).id;
+	const auto b = m.addKeyFrame(makeKf(CPose3D(0.1, 0, 0, 0, 0, 0), 40)).id;
+	std::vector<LandmarkId> lms;
+	for (int i = 0; i < 30; i++)
+	{
+		lms.push_back(m.addLandmark({0.1 * i, 0, 2}, a, i));
+		if (i < 20) m.addObservation(lms.back(), b, i + 5);
+	}
+	m.updateCovisibility(b);
+	EXPECT_EQ(m.keyframe(a).covisibility.at(b), 20);
+	EXPECT_EQ(m.keyframe(b).covisibility.at(a), 20);
+	EXPECT_EQ(m.bestCovisibles(a, 5), std::vector<KeyFrameId>{b});
+	EXPECT_EQ(m.keyframe(b).trackedLandmarks(), 20);
+	// Fusing a duplicate moves its observations.
+	const auto dup = m.addLandmark({5, 5, 5}, b, 30);
+	m.replaceLandmark(dup, lms[25]);
+	EXPECT_FALSE(m.hasLandmark(dup));
+	EXPECT_EQ(m.keyframe(b).landmarks[30], lms[25]);
+	EXPECT_EQ(m.landmark(lms[25]).observations.size(), 2u);
+	// Erasing a keyframe keeps landmarks seen elsewhere and drops the orphans.
+	m.keyframe(b).parent = a;
+	m.keyframe(b).hasParent = true;
+	m.eraseKeyFrame(a);
+	EXPECT_FALSE(m.hasKeyFrame(a));
+	EXPECT_TRUE(m.hasLandmark(lms[0]));
+	EXPECT_FALSE(m.hasLandmark(lms[29]));
+}
+
+TEST(SparseMap, ErasedKeyFramePosesFollowTheirParent)
+{
+	SparseMap m;
+	const auto a = m.addKeyFrame(makeKf(CPose3D(1, 2, 3, 0.1, 0.2, 0.3), 1)).id;
+	KeyFrame kb = makeKf(CPose3D(1.5, 2, 3, 0.2, 0.2, 0.3), 1);
+	kb.parent = a;
+	kb.hasParent = true;
+	const auto b = m.addKeyFrame(std::move(kb)).id;
+	const CPose3D T_a_b = m.keyframe(b).T_world_cam - m.keyframe(a).T_world_cam;
+	m.eraseKeyFrame(b);
+	// The parent moves (e.g. bundle adjustment): the erased child follows rigidly.
+	m.keyframe(a).T_world_cam = CPose3D(0, 0, 0, 0, 0, 0);
+	CPose3D T;
+	ASSERT_TRUE(m.poseOf(b, T));
+	EXPECT_NEAR((T.asVectorVal() - T_a_b.asVectorVal()).norm(), 0.0, 1e-12);
+	EXPECT_FALSE(m.poseOf(99, T));
+}
