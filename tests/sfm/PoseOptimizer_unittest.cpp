@@ -132,3 +132,23 @@ TEST(RgbdReprojectionCost, AutoDiffJacobianMatchesFiniteDifferences)
 	delete ad;
 	delete nd;
 }
+
+#include <keygrid/sfm/Triangulation.h>
+
+TEST(Triangulation, DltRecoversAPointFromTwoViews)
+{
+	const CPose3D T1(0, 0, 0, 0, 0, 0), T2(0.3, 0.05, -0.02, 0.1, -0.05, 0.02);
+	const Eigen::Vector3d p(0.4, -0.3, 2.5);
+	auto project = [&](const CPose3D& T) {
+		double x, y, z;
+		(-T).composePoint(p.x(), p.y(), p.z(), x, y, z);
+		return Eigen::Vector2d(K.fx * x / z + K.cx, K.fy * y / z + K.cy);
+	};
+	Eigen::Vector3d est;
+	ASSERT_TRUE(triangulateDlt(T1, project(T1), T2, project(T2), K, est));
+	EXPECT_NEAR((est - p).norm(), 0.0, 1e-9);
+	EXPECT_NEAR(parallaxAngle(T1, T2, p), std::acos((p.normalized()).dot((p - Eigen::Vector3d(0.3, 0.05, -0.02)).normalized())), 1e-12);
+	// Diverging rays (the right camera looks further right) meet behind both cameras: rejected.
+	const CPose3D Tright(0.3, 0, 0, 0, 0, 0);
+	EXPECT_FALSE(triangulateDlt(T1, Eigen::Vector2d(K.cx + 50, K.cy), Tright, Eigen::Vector2d(K.cx + 100, K.cy), K, est));
+}

@@ -1,7 +1,10 @@
 #include <keygrid/sfm/LocalMapper.h>
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <keygrid/sfm/Triangulation.h>
+
 #include <algorithm>
+#include <cmath>
 #include <set>
 
 namespace keygrid::sfm
@@ -13,7 +16,10 @@ void LocalMapperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 	fuseMaxDistanceOrb = c.read_float(s, "fuse_max_distance_orb", fuseMaxDistanceOrb);
 	minFoundRatio = c.read_double(s, "min_found_ratio", minFoundRatio);
 	redundantKeyFrameRatio = c.read_double(s, "redundant_keyframe_ratio", redundantKeyFrameRatio);
+	triangulationNeighbours = c.read_int(s, "triangulation_neighbours", triangulationNeighbours);
+	minParallaxDeg = c.read_double(s, "min_parallax_deg", minParallaxDeg);
 	localBundleAdjustment = c.read_bool(s, "local_bundle_adjustment", localBundleAdjustment);
+	if (triangulationNeighbours < 0) throw std::invalid_argument("[" + s + "] triangulation_neighbours must be >= 0");
 	if (fuseNeighbours < 0) throw std::invalid_argument("[" + s + "] fuse_neighbours must be >= 0");
 	if (!(redundantKeyFrameRatio > 0 && redundantKeyFrameRatio <= 1.0))
 		throw std::invalid_argument("[" + s + "] redundant_keyframe_ratio = " + std::to_string(redundantKeyFrameRatio) + " (must be in (0, 1])");
@@ -27,6 +33,8 @@ void LocalMapperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, cons
 	c.write(s, "fuse_max_distance_orb", fuseMaxDistanceOrb, 30, 40, "fusion descriptor threshold [bits]");
 	c.write(s, "min_found_ratio", minFoundRatio, 30, 40, "new landmarks matched less often are culled");
 	c.write(s, "redundant_keyframe_ratio", redundantKeyFrameRatio, 30, 40, "keyframes this redundant are culled");
+	c.write(s, "triangulation_neighbours", triangulationNeighbours, 30, 40, "keyframes searched for triangulated landmarks");
+	c.write(s, "min_parallax_deg", minParallaxDeg, 30, 40, "smallest parallax of a triangulated landmark [deg]");
 	c.write(s, "local_bundle_adjustment", localBundleAdjustment, 30, 40, "");
 	ba.saveToConfigFile(c, s);
 }
@@ -45,12 +53,57 @@ LocalMappingReport LocalMapper::process(KeyFrameId kf, const PinholeIntrinsics& 
 	rep.culledLandmarks = cullRecentLandmarks(kf);
 	if (m_map.numKeyFrames() > 1)
 	{
+		rep.triangulated = triangulateNew(kf, K);
 		fuse(kf, K, rep);
 		m_map.updateCovisibility(kf);
 		if (m_opts.localBundleAdjustment) rep.ba = localBundleAdjustment(m_map, kf, K, m_opts.ba);
 		rep.culledKeyFrames = cullKeyFrames(kf);
 	}
 	return rep;
+}
+
+int LocalMapper::triangulateNew(KeyFrameId kfId, const PinholeIntrinsics& K)
+{
+	int created = 0;
+	const double cosMaxParallax = std::cos(m_opts.minParallaxDeg * M_PI / 180.0);
+	for (KeyFrameId nId : m_map.bestCovisibles(kfId, static_cast<std::size_t>(m_opts.triangulationNeighbours)))
+	{
+		auto& a = m_map.keyframe(kfId);
+		const auto& b = m_map.keyframe(nId);
+		// Baseline too short for the scene depth: nothing to gain.
+		if ((a.cameraCenter() - b.cameraCenter()).norm() < 0.01) continue;
+		for (const auto& [i, j] : matchBruteForce(a.features, b.features, m_matcher))
+		{
+			if (a.landmarks[i] != kNoLandmark || b.landmarks[j] != kNoLandmark) continue;
+			// Points with valid depth in the new keyframe already became landmarks (or were
+			// rejected); triangulation is for the others.
+			if (a.features.depth[i] > 0) continue;
+			const Eigen::Vector2d ua(a.features.undistorted[i].x, a.features.undistorted[i].y);
+			const Eigen::Vector2d ub(b.features.undistorted[j].x, b.features.undistorted[j].y);
+			Eigen::Vector3d p;
+			if (!triangulateDlt(a.T_world_cam, ua, b.T_world_cam, ub, K, p)) continue;
+			if (std::cos(parallaxAngle(a.T_world_cam, b.T_world_cam, p)) > cosMaxParallax) continue;
+			// Reprojection in both views within the 2-DOF chi-square bound at their levels.
+			bool ok = true;
+			for (const KeyFrame* k : {static_cast<const KeyFrame*>(&a), &b})
+			{
+				const int kp = k == &a ? i : j;
+				double x, y, z;
+				(-k->T_world_cam).composePoint(p.x(), p.y(), p.z(), x, y, z);
+				const double s = k->features.levelScale[k->features.keypoints[kp].octave];
+				const double du = K.fx * x / z + K.cx - k->features.undistorted[kp].x;
+				const double dv = K.fy * y / z + K.cy - k->features.undistorted[kp].y;
+				if ((du * du + dv * dv) / (s * s) > 5.991) ok = false;
+			}
+			if (!ok) continue;
+			const LandmarkId id = m_map.addLandmark(p, kfId, i);
+			m_map.addObservation(id, nId, j);
+			m_map.updateLandmarkStats(id);
+			m_recent.push_back(id);
+			++created;
+		}
+	}
+	return created;
 }
 
 int LocalMapper::cullRecentLandmarks(KeyFrameId current)

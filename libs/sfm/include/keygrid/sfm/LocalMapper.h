@@ -32,6 +32,10 @@ struct LocalMapperOptions
 	/** A keyframe is culled when this share of its landmarks is seen by >= 3 other keyframes
 	 * at the same or a finer scale (Default: 0.9) */
 	double redundantKeyFrameRatio{0.9};
+	/** Keyframes searched for new landmarks by triangulation of keypoints without one (Default: 5) */
+	int triangulationNeighbours{5};
+	/** Smallest parallax for a triangulated landmark [deg] (Default: 1.0) */
+	double minParallaxDeg{1.0};
 	/** Run local bundle adjustment (Default: true) */
 	bool localBundleAdjustment{true};
 	BundleAdjusterOptions ba;
@@ -42,7 +46,7 @@ struct LocalMapperOptions
 
 struct LocalMappingReport
 {
-	int culledLandmarks{0}, fusedLandmarks{0}, addedObservations{0}, culledKeyFrames{0};
+	int culledLandmarks{0}, fusedLandmarks{0}, addedObservations{0}, culledKeyFrames{0}, triangulated{0};
 	BundleAdjusterReport ba;
 };
 
@@ -57,6 +61,8 @@ class LocalMapper
 
    private:
 	int cullRecentLandmarks(KeyFrameId current);
+	/** New landmarks from keypoints without one, matched with neighbour keyframes. */
+	int triangulateNew(KeyFrameId kf, const PinholeIntrinsics& K);
 	void fuse(KeyFrameId kf, const PinholeIntrinsics& K, LocalMappingReport& rep);
 	/** Projects `lms` into keyframe `target`; merges duplicates, adds missing observations. */
 	void fuseInto(KeyFrameId target, const std::vector<LandmarkId>& lms, const PinholeIntrinsics& K, LocalMappingReport& rep);
