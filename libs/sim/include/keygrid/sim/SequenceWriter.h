@@ -1,0 +1,64 @@
+#pragma once
+/** \file SequenceWriter.h
+ * Writes a simulated sequence to a folder:
+ *   DIR/sequence.rawlog        CObservation3DRangeScan per frame (core::makeRgbdObservation)
+ *   DIR/groundtruth.txt        TUM: T_world_cam of the optical frame, one pose per frame
+ *   DIR/tum/                   rgb/ depth/ [mask/] rgb.txt depth.txt associations.txt
+ *                              groundtruth.txt camera.ini (TUM RGB-D layout, depth = raw/5000 m)
+ *   DIR/occupancy_voxels.txt   static-scene surface voxels (VoxelSet)
+ *   DIR/floorplan.pgm/.yaml    static-scene 2D floor plan (FloorPlan, ROS map_server)
+ */
+#include <cstddef>
+#include <functional>
+#include <string>
+
+namespace mrpt::config
+{
+class CConfigFileBase;
+}
+
+namespace keygrid::sim
+{
+class Scene;
+
+/** The [output] section. */
+struct OutputOptions
+{
+	/** Write DIR/sequence.rawlog (Default: true) */
+	bool writeRawlog{true};
+	/** Write DIR/tum/ (Default: true) */
+	bool writeTum{true};
+	/** Write DIR/tum/mask/ PNGs, 255 = dynamic object pixel (Default: false) */
+	bool writeMask{false};
+	/** Store rawlog images as external PNGs in sequence_Images/ (Default: false) */
+	bool externalImages{false};
+	/** Ground-truth voxel size [m]; 0 disables the voxel file (Default: 0.05) */
+	double voxelResolution{0.05};
+	/** Floor-plan cell size [m]; 0 disables the floor plan (Default: 0.05) */
+	double floorPlanResolution{0.05};
+	/** Height band of the floor plan [m, world z] (Default: 0.1 .. 1.8) */
+	double floorPlanZMin{0.1}, floorPlanZMax{1.8};
+	/** PNG compression level 0-9 for TUM images (Default: 1: fast) */
+	int pngCompression{1};
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+};
+
+struct SequenceSummary
+{
+	std::size_t frames{0};
+	std::size_t voxels{0}, floorPlanCells{0};
+	double seconds{0};                      //!< wall time of the whole run
+	double renderSeconds{0};                //!< of which rendering + sensor model
+	double maxSpeed{0}, maxTurnRateDeg{0};  //!< of the camera trajectory
+	double dynamicPixelFraction{0};         //!< mean over frames
+};
+
+/** Renders every frame of `scene` and writes the outputs above into `dir` (created if
+ * needed). `progress(done, total)` is called after each frame when given. */
+SequenceSummary writeSequence(
+	const Scene& scene, const std::string& dir, const OutputOptions& opts,
+	const std::function<void(std::size_t, std::size_t)>& progress = {}, unsigned threads = 0);
+
+}  // namespace keygrid::sim
