@@ -1,36 +1,41 @@
 #!/usr/bin/env bash
 # `make demo`: the main job on data the project makes itself.
-# Until keygrid-slam exists, the demo exercises the conversion and evaluation pipeline:
-#   1. writes a small TUM RGB-D folder (a textured plane seen from a moving camera, with its
-#      ground-truth trajectory) using keygrid-sim;
-#   2. converts it to an MRPT rawlog with keygrid-tum2rawlog (readable by RawLogViewer);
-#   3. evaluates a perturbed copy of the trajectory with keygrid-eval.
+#   1. keygrid-sim renders config/sim/room_loop.ini (a furnished room, the camera circles it and
+#      returns to its start; Kinect-like noise; exact ground truth);
+#   2. keygrid-slam runs config/sim.ini on the rendered rawlog: trajectory, keyframes, the 2D ISM
+#      navigation grid and the submapped 3D occupancy grid;
+#   3. keygrid-eval scores the trajectory against the ground truth.
 set -euo pipefail
 build="${1:-build}"
 bin="$build/bin"
 out="${KEYGRID_DEMO_OUT:-out/demo}"
 mkdir -p "$out"
+start=$(date +%s)
 
-if [ -x "$bin/keygrid-sim" ] && [ -f config/sim/room_loop.ini ]; then
-  echo "== keygrid-sim: generating config/sim/room_loop.ini into $out/sim =="
-  "$bin/keygrid-sim" --scene config/sim/room_loop.ini --output "$out/sim"
-  tum="$out/sim/tum"
-else
-  echo "keygrid-sim is not built; see doc/user-guide.md" >&2
-  exit 1
-fi
+echo "== 1/3 keygrid-sim: config/sim/room_loop.ini -> $out/sim"
+"$bin/keygrid-sim" --scene config/sim/room_loop.ini --output "$out/sim"
 
-echo "== keygrid-tum2rawlog =="
-"$bin/keygrid-tum2rawlog" --input "$tum" --output "$out/sequence.rawlog"
+echo "== 2/3 keygrid-slam: config/sim.ini on $out/sim/sequence.rawlog -> $out/slam"
+"$bin/keygrid-slam" --config config/sim.ini --input "$out/sim/sequence.rawlog" \
+  --output "$out/slam" --gt "$out/sim/groundtruth.txt"
 
-echo "== keygrid-eval: ground truth vs itself, then vs a drifting copy =="
-awk '!/^#/ && NF==8 { printf "%s %.9f %.9f %.9f %s %s %s %s\n", $1, $2*1.01, $3*1.01, $4, $5, $6, $7, $8 }' \
-  "$tum/groundtruth.txt" > "$out/drifting_estimate.txt"
-"$bin/keygrid-eval" --gt "$tum/groundtruth.txt" --est "$tum/groundtruth.txt"
-"$bin/keygrid-eval" --gt "$tum/groundtruth.txt" --est "$out/drifting_estimate.txt" --json "$out/eval.json"
+echo "== 3/3 keygrid-eval"
+"$bin/keygrid-eval" --gt "$out/sim/groundtruth.txt" --est "$out/slam/trajectory.txt" --json "$out/slam/eval.json"
 
+python3 - "$out/slam/report.json" "$(( $(date +%s) - start ))" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))
+print()
+print(f"keygrid demo finished in {sys.argv[2]} s")
+print(f"  frames {r['frames']}, tracked {r['tracked']}, {r['fps']:.1f} fps, keyframes {r['keyframes']}, landmarks {r['landmarks']}")
+if 'ate_rmse_m' in r: print(f"  ATE RMSE {100*r['ate_rmse_m']:.2f} cm against the simulator's ground truth")
+print(f"  loop closures: {len(r.get('loop_closures', []))}")
+for m in r.get('maps', []): print("  map", m)
+PY
 echo
-echo "Outputs in $out:"
-echo "  sequence.rawlog           open with: RawLogViewer $out/sequence.rawlog"
-echo "  $tum/                     TUM layout (rgb/, depth/, groundtruth.txt)"
-echo "  eval.json                 ATE/RPE of the 1 %-scaled trajectory"
+echo "Outputs:"
+echo "  $out/sim/                 rendered sequence (sequence.rawlog, tum/, groundtruth.txt, floorplan.pgm)"
+echo "  $out/slam/trajectory.txt  estimated trajectory (TUM format); report.json, frames.csv"
+echo "  $out/slam/map_2d.png      2D navigation grid (also map_2d.pgm + map_2d.yaml for map_server)"
+echo "  $out/slam/map_3d.bt       3D occupancy grid (octovis $out/slam/map_3d.bt); map_3d.ply"
+echo "  RawLogViewer $out/sim/sequence.rawlog   to browse the input"

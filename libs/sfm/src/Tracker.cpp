@@ -307,7 +307,9 @@ int Tracker::trackLocalMap(Current& cur, float radius)
 bool Tracker::needKeyFrame(const Current& cur) const
 {
 	const int sinceLast = static_cast<int>(cur.frame->index - m_lastKfFrame);
-	const int minObs = m_map.numKeyFrames() > 2 ? 3 : 2;
+	// Landmarks of the reference keyframe also seen by other keyframes (ORB-SLAM2's "3
+	// observations", where an RGB-D observation counts twice, is 2 keyframes).
+	const int minObs = m_map.numKeyFrames() > 2 ? m_opts.keyFrameRefMinObservations : 1;
 	const int refMatches = m_map.hasKeyFrame(m_refKf) ? m_map.keyframe(m_refKf).trackedLandmarks(minObs, &m_map) : 0;
 	int trackedClose = 0, newClose = 0;
 	for (std::size_t i = 0; i < cur.features.size(); i++)

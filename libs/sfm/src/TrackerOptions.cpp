@@ -25,6 +25,7 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	relocalizationCandidates = c.read_int(s, "relocalization_candidates", relocalizationCandidates);
 	maxFramesBetweenKeyFrames = c.read_int(s, "max_frames_between_keyframes", maxFramesBetweenKeyFrames);
 	keyFrameTrackedRatio = c.read_double(s, "keyframe_tracked_ratio", keyFrameTrackedRatio);
+	keyFrameRefMinObservations = c.read_int(s, "keyframe_ref_min_observations", keyFrameRefMinObservations);
 	closeDepth = c.read_double(s, "close_depth", closeDepth);
 	minTrackedClose = c.read_int(s, "min_tracked_close", minTrackedClose);
 	minNewClose = c.read_int(s, "min_new_close", minNewClose);
@@ -44,6 +45,7 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	positive(s, "local_keyframes", localKeyFrames);
 	positive(s, "max_frames_between_keyframes", maxFramesBetweenKeyFrames);
 	positive(s, "bf", pose.bf);
+	positive(s, "keyframe_ref_min_observations", keyFrameRefMinObservations);
 	positive(s, "pose_rounds", pose.rounds);
 	positive(s, "pose_iterations", pose.iterationsPerRound);
 	if (!(keyFrameTrackedRatio > 0 && keyFrameTrackedRatio <= 1))
@@ -63,6 +65,7 @@ void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "relocalization_candidates", relocalizationCandidates, 34, 40, "keyframes tried when lost");
 	c.write(s, "max_frames_between_keyframes", maxFramesBetweenKeyFrames, 34, 40, "");
 	c.write(s, "keyframe_tracked_ratio", keyFrameTrackedRatio, 34, 40, "new keyframe below this share of the reference's landmarks");
+	c.write(s, "keyframe_ref_min_observations", keyFrameRefMinObservations, 34, 40, "reference landmarks counted: seen by >= this many keyframes");
 	c.write(s, "close_depth", closeDepth, 34, 40, "[m]");
 	c.write(s, "min_tracked_close", minTrackedClose, 34, 40, "");
 	c.write(s, "min_new_close", minNewClose, 34, 40, "");

@@ -20,6 +20,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	refinement.refineFrames = c.read_bool("refinement", "refine_frames", refinement.refineFrames);
 	if (refinement.globalIterations < 1)
 		throw std::invalid_argument("[refinement] global_iterations = " + std::to_string(refinement.globalIterations) + " (must be >= 1)");
+	maps.loadFromConfigFile(c, "maps");
 	// The depth residual model is shared by tracking and bundle adjustment.
 	mapping.ba.bf = tracker.pose.bf;
 }
@@ -33,6 +34,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	mapping.saveToConfigFile(c, "mapping");
 	c.write("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment, 30, 40, "bundle-adjust everything after the last frame");
 	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "");
+	maps.saveToConfigFile(c, "maps");
 	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame against the final map");
 }
 

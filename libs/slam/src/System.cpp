@@ -37,11 +37,22 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	if (!m_K) m_K = K;
 	sfm::TrackedFrame tf = m_tracker.track(frame, std::move(features));
 	m_timings.add("track", secondsSince(t0));
+	if (tf.tracked)
+	{
+		if (m_lastTrackedPose) m_travelled += (tf.T_world_cam.translation() - m_lastTrackedPose->translation()).norm();
+		m_lastTrackedPose = tf.T_world_cam;
+	}
 	if (tf.newKeyFrame)
 	{
 		t0 = std::chrono::steady_clock::now();
 		const auto rep = m_mapper.process(tf.keyframe, K);
 		m_timings.add("local_mapping", secondsSince(t0));
+		if (m_maps && m_map.hasKeyFrame(tf.keyframe))
+		{
+			t0 = std::chrono::steady_clock::now();
+			m_maps->insertKeyFrame(m_map, tf.keyframe, m_travelled);
+			m_timings.add("map_insertion", secondsSince(t0));
+		}
 		m_stats.keyframesCreated++;
 		m_stats.keyframesCulled += rep.culledKeyFrames;
 		m_stats.landmarksCulled += rep.culledLandmarks;
@@ -73,6 +84,17 @@ void System::finish()
 		sfm::globalBundleAdjustment(m_map, *m_K, o);
 	}
 	m_timings.add("global_bundle_adjustment", secondsSince(t0));
+	if (m_maps)
+	{
+		// Re-anchor the maps on the refined keyframe poses (erased keyframes via their parents).
+		std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> poses;
+		for (const auto& f : m_frames)
+		{
+			mrpt::poses::CPose3D T;
+			if (f.newKeyFrame && m_map.poseOf(f.keyframe, T)) poses[f.keyframe] = T;
+		}
+		for (const auto& [name, sec] : m_maps->applyCorrection(poses)) m_timings.add("map_correction:" + name, sec);
+	}
 	if (!m_cfg.refinement.refineFrames) return;
 	const auto t1 = std::chrono::steady_clock::now();
 	const auto base = trajectory();

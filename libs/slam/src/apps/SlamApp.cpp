@@ -8,6 +8,7 @@
 #include <keygrid/slam/System.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/SlamApp.h>
+#include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/system/filesystem.h>
 
@@ -73,6 +74,11 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (!o.groundTruth.empty()) gt = core::readTumTrajectory(o.groundTruth);
 
 	System sys(cfg);
+	{
+		mrpt::config::CConfigFile ini(o.configPath);
+		auto maps = std::make_unique<MetricMaps>(ini, cfg.maps);
+		if (!maps->empty()) sys.attachMaps(std::move(maps));
+	}
 	SlamRunResult res;
 	const std::size_t total = o.maxFrames ? std::min(o.maxFrames, source->sizeHint().value_or(o.maxFrames)) : source->sizeHint().value_or(0);
 	core::ProgressBar bar("keygrid-slam", total, !o.quiet);
@@ -173,6 +179,18 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	}
 	writeFileAtomically(o.output + "/keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
 
+	std::vector<std::string> mapFiles;
+	if (sys.metricMaps())
+	{
+		try
+		{
+			mapFiles = sys.metricMaps()->writeOutputs(o.output);
+		}
+		catch (const std::exception& e)
+		{
+			if (res.error.empty()) res.error = std::string("writing maps: ") + e.what();
+		}
+	}
 	res.frames = sys.stats().frames;
 	res.tracked = sys.stats().tracked;
 	res.fps = res.frames / std::max(wall, 1e-9);
@@ -209,6 +227,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "  \"landmarks_culled\": " << st.landmarksCulled << ",\n";
 	js << "  \"landmarks_fused\": " << st.landmarksFused << ",\n";
 	js << "  \"loop_closures\": [],\n";
+	js << "  \"maps\": " << (sys.metricMaps() ? sys.metricMaps()->summaryJson() : std::string("[]")) << ",\n";
 	{
 		char m[256];
 		const double kfs = std::max<std::size_t>(1, st.keyframesCreated);

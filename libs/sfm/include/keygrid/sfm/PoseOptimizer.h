@@ -12,8 +12,8 @@ namespace keygrid::sfm
 {
 struct PoseObservation
 {
-	Eigen::Vector3d p_world;
-	Eigen::Vector2d uv;  //!< undistorted pixel
+	Eigen::Vector3d p_world{Eigen::Vector3d::Zero()};
+	Eigen::Vector2d uv{Eigen::Vector2d::Zero()};  //!< undistorted pixel
 	double depth{0};     //!< measured depth [m], 0 = none
 	double invSigma{1};  //!< 1 / scaleFactor^level
 };

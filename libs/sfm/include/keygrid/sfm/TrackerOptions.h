@@ -34,8 +34,12 @@ struct TrackerOptions
 
 	/** A keyframe at the latest after this many frames (Default: 30) */
 	int maxFramesBetweenKeyFrames{30};
-	/** Insert when tracked landmarks fall below this fraction of the reference keyframe's (Default: 0.75) */
-	double keyFrameTrackedRatio{0.75};
+	/** Insert when tracked landmarks fall below this fraction of the reference keyframe's (Default: 0.5) */
+	double keyFrameTrackedRatio{0.5};
+	/** Reference-keyframe landmarks counted by that ratio: those seen by at least this many
+	 * keyframes (Default: 1, all of them. ORB-SLAM2's RGB-D rule, 2 with ratio 0.75, gave
+	 * fewer keyframes and 2-3x the error on the synthetic room loops: doc/evaluation.md) */
+	int keyFrameRefMinObservations{1};
 	/** Depth under which points count as "close" (well-measured) [m] (Default: 3.0) */
 	double closeDepth{3.0};
 	/** Insert when fewer close points are tracked than this and ... (Default: 100) */

@@ -3,11 +3,14 @@
  * Everything one keygrid-slam run is configured with, loaded from one INI file.
  *
  * Sections: [slam] (mode, camera), [features], [tracker], [mapping] (local mapping and local
- * bundle adjustment), [refinement] (final global bundle adjustment and frame re-estimation). Keys absent from the file keep their documented defaults.
+ * bundle adjustment), [refinement] (final global bundle adjustment and frame re-estimation),
+ * [maps] (how keyframes feed the maps) and [MappingApplication] (the maps themselves, MRPT's
+ * CMultiMetricMap format, see MetricMaps). Keys absent from the file keep their documented defaults.
  */
 #include <keygrid/sfm/FeatureExtractor.h>
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/TrackerOptions.h>
+#include <keygrid/slam/MetricMaps.h>
 
 #include <string>
 
@@ -35,6 +38,7 @@ struct SlamConfig
 	sfm::TrackerOptions tracker;
 	sfm::LocalMapperOptions mapping;
 	RefinementOptions refinement;
+	MapFeedOptions maps;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;

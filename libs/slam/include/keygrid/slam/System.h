@@ -9,6 +9,7 @@
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <keygrid/slam/StageTimings.h>
 
@@ -37,6 +38,10 @@ class System
 	/** extract + processExtracted. */
 	const sfm::TrackedFrame& process(const core::Frame& frame);
 
+	/** Maps fed with every keyframe (optional; see MetricMaps). */
+	void attachMaps(std::unique_ptr<MetricMaps> maps) { m_maps = std::move(maps); }
+	const MetricMaps* metricMaps() const { return m_maps.get(); }
+
 	/** After the last frame: global bundle adjustment and frame re-estimation, as configured
 	 * in [refinement]. Idempotent. */
 	void finish();
@@ -64,6 +69,9 @@ class System
 	std::vector<std::optional<mrpt::poses::CPose3D>> m_refined;
 	std::optional<sfm::PinholeIntrinsics> m_K;
 	bool m_finished{false};
+	std::unique_ptr<MetricMaps> m_maps;
+	double m_travelled{0};
+	std::optional<mrpt::poses::CPose3D> m_lastTrackedPose;
 	SystemStats m_stats;
 	StageTimings m_timings;
 };

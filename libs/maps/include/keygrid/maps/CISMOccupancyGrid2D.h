@@ -1,0 +1,303 @@
+#pragma once
+/** \file CISMOccupancyGrid2D.h
+ * A 2D navigation occupancy grid filled from visual-SLAM keyframes with the erf inverse sensor
+ * model of Lu & Wang (2018). MRPT CMetricMap plugin registered as "ismOccupancyGrid2D".
+ */
+#include <keygrid/maps/FloorPlaneEstimator.h>
+#include <keygrid/maps/InverseSensorModel.h>
+#include <mrpt/config/CLoadableOptions.h>
+#include <mrpt/maps/CMetricMap.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/math/TPoint3D.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/poses/CPose3D.h>
+
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace keygrid
+{
+/** Tri-state classification of a cell. */
+enum class CellState : uint8_t
+{
+	Unknown = 0,
+	Free = 1,
+	Occupied = 2
+};
+
+/** 2D occupancy grid in the floor plane, updated in log-odds with the practical (erf) ISM.
+ *
+ * Frames: the grid lives in the floor frame F (z up, z = 0 on the floor); its pose in the
+ * world is insertionOptions.T_world_floor, or a RANSAC estimate of the floor plane from the
+ * first depth image when insertionOptions.estimateFloorFromDepth is set (TUM's world frame is
+ * not gravity aligned). A 3D point p_F is an obstacle when obstacleMinHeight <= z <=
+ * obstacleMaxHeight, floor when |z| <= floorTolerance (it then only clears space), and ignored
+ * otherwise. Every kept point casts a 2D ray from the camera's footprint to the point's
+ * footprint; the cells on it are updated with l += logit(ISM(r)) - l0.
+ *
+ * Storage: float log-odds per cell in a grid that grows on demand (in steps of
+ * creationOptions.growthMargin) from the creation extent, because a SLAM map's extent is not
+ * known in advance; cells outside the grid read as unknown.
+ *
+ * Inputs: insertKeyframePoints() (sparse map points, the paper's input), insertKeyframeDepth()
+ * and insertObservation(CObservation3DRangeScan) (dense depth, reduced to one ray per endpoint
+ * cell). Each keyframe's rays are kept in the camera frame, so applyTrajectoryCorrection()
+ * rebuilds the grid under corrected poses after a loop closure.
+ */
+class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
+{
+	DEFINE_SERIALIZABLE(CISMOccupancyGrid2D, keygrid)
+
+   public:
+	/** Creation options: the grid geometry. */
+	struct TCreationOptions : public mrpt::config::CLoadableOptions
+	{
+		/** Cell size [m] (Default: 0.05 m) */
+		double resolution{0.05};
+		/** Initial extent in the floor frame [m] (Default: -5..5 x -5..5 m) */
+		double min_x{-5.0}, max_x{5.0}, min_y{-5.0}, max_y{5.0};
+		/** Extra border added when the grid has to grow [m] (Default: 2 m) */
+		double growthMargin{2.0};
+
+		void loadFromConfigFile(
+			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
+		void saveToConfigFile(
+			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
+		/** Throws std::invalid_argument naming the key on a bad value. */
+		void validate() const;
+	};
+
+	/** Ray traversal used to distribute the ISM over cells. */
+	enum class RayTraversal : uint8_t
+	{
+		Bresenham = 0,
+		AntiAliased = 1  ///< Xiaolin Wu: two cells per step, weights sum to one
+	};
+
+	/** Insertion options: ISM, noise, height band, floor frame, traversal, thresholds. */
+	struct TInsertionOptions : public mrpt::config::CLoadableOptions
+	{
+		/** Ideal-model occupancy before the band (Default: 0.30) */
+		double pFree{0.30};
+		/** Ideal-model occupancy inside the band (Default: 0.90) */
+		double pOccupied{0.90};
+		/** Prior occupancy p0, l0 = logit(p0); also the value of unknown cells (Default: 0.5) */
+		double pPrior{0.5};
+		/** Occupied band width L [m]; 0 = the cell diagonal, resolution*sqrt(2) (Default: 0) */
+		double bandWidth{0.0};
+		/** Range noise model: "constant" or "kinect" (Default: kinect) */
+		maps::RangeNoiseModel rangeNoise{maps::RangeNoiseModel::Kinect};
+		/** sigma of the "constant" model [m] (Default: 0.02 m) */
+		double sigmaConstant{0.02};
+		/** Log-odds clamping limits (Default: -2.0 and 3.5, i.e. p in [0.12, 0.97]) */
+		double logOddsMin{-2.0}, logOddsMax{3.5};
+		/** Points whose horizontal distance to the camera exceeds this are ignored [m]
+		 * (Default: 4.5 m) */
+		double maxRange{4.5};
+		/** Obstacle height band above the floor [m] (Default: 0.10 .. 1.80 m) */
+		double obstacleMinHeight{0.10}, obstacleMaxHeight{1.80};
+		/** Points within +-this of the floor are floor: they clear their ray [m]
+		 * (Default: 0.04 m) */
+		double floorTolerance{0.04};
+		/** Pose of the floor frame (z up) in the world (Default: identity) */
+		mrpt::poses::CPose3D T_world_floor;
+		/** Estimate the floor plane by RANSAC from the first depth image instead of
+		 * T_world_floor (Default: false) */
+		bool estimateFloorFromDepth{false};
+		/** "Up" direction in the world for that estimate, INI "floorUpHint = x y z"; (0,0,0)
+		 * means the first camera's -y axis (camera held upright) (Default: 0 0 0) */
+		mrpt::math::TVector3D floorUpHint{0, 0, 0};
+		/** RANSAC parameters of that estimate */
+		maps::FloorPlaneRansacOptions floorRansac;
+		/** Ray traversal: "bresenham" or "antialiased" (Default: bresenham) */
+		RayTraversal rayTraversal{RayTraversal::Bresenham};
+		/** Dense depth: use every n-th pixel in rows and columns (Default: 1) */
+		int depthDecimation{1};
+		/** Dense depth: minimum points in an endpoint cell before it casts an obstacle ray,
+		 * rejects speckle (Default: 2) */
+		int minPointsPerCell{2};
+		/** Tri-state thresholds on the occupancy probability: p >= occupied -> Occupied,
+		 * p <= free -> Free, else Unknown (Default: 0.65 and 0.35) */
+		double occupiedThreshold{0.65}, freeThreshold{0.35};
+
+		/** The ISM shape these options define at a given resolution (L = 0 -> diagonal). */
+		maps::IsmShape ismShape(double resolution) const;
+
+		void loadFromConfigFile(
+			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
+		void saveToConfigFile(
+			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
+		/** Throws std::invalid_argument naming the key on a bad value. */
+		void validate() const;
+	};
+
+	/** Likelihood options for computeObservationLikelihood(CObservation3DRangeScan). */
+	struct TLikelihoodOptions : public mrpt::config::CLoadableOptions
+	{
+		/** Use every n-th depth pixel in rows and columns (Default: 8) */
+		int decimation{8};
+		/** Probability floor mixed into each point's cell occupancy (Default: 0.05) */
+		double outlierProbability{0.05};
+
+		void loadFromConfigFile(
+			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
+		void saveToConfigFile(
+			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
+		void validate() const;
+	};
+
+	/** One keyframe's stored rays: camera pose and ray endpoints in the optical frame. */
+	struct KeyframeRays
+	{
+		mrpt::poses::CPose3D T_world_cam;
+		std::vector<mrpt::math::TPoint3Df> points_cam;
+	};
+
+	TCreationOptions creationOptions;
+	TInsertionOptions insertionOptions;
+	TLikelihoodOptions likelihoodOptions;
+
+	/** An empty grid with default options. */
+	CISMOccupancyGrid2D();
+	/** An empty grid with the given geometry (validated). */
+	explicit CISMOccupancyGrid2D(const TCreationOptions& creation);
+
+	/** @name Inputs
+	 * @{ */
+	/** Sparse input (the paper's): a keyframe's pose and its map points in world coordinates.
+	 * Stores the points (camera frame) under `keyframeId` (replacing an earlier entry) and
+	 * updates the grid. Returns false if the floor frame is still unknown (estimateFloorFromDepth
+	 * before any depth image): the points are then only stored, and enter the grid at the next
+	 * applyTrajectoryCorrection(). */
+	bool insertKeyframePoints(
+		uint64_t keyframeId, const mrpt::poses::CPose3D& T_world_cam,
+		const std::vector<mrpt::math::TPoint3D>& points_world);
+	/** Dense input: a depth image (MRPT depth frame, obs.sensorPose = T_robot_depth) with the
+	 * keyframe camera pose. Estimates the floor first if so configured. The depth is reduced to
+	 * one ray per endpoint cell, and those rays are stored under `keyframeId`. */
+	bool insertKeyframeDepth(
+		uint64_t keyframeId, const mrpt::poses::CPose3D& T_world_cam,
+		const mrpt::obs::CObservation3DRangeScan& obs);
+	/** Rebuilds the grid from the stored keyframes, with `newPoses` replacing the poses of the
+	 * keyframes it names (others keep theirs). Returns the wall time taken [s], also kept in
+	 * lastRebuildSeconds(). Unknown ids throw std::out_of_range. */
+	double applyTrajectoryCorrection(const std::map<uint64_t, mrpt::poses::CPose3D>& newPoses);
+	double lastRebuildSeconds() const { return m_lastRebuildSeconds; }
+	const std::map<uint64_t, KeyframeRays>& keyframes() const { return m_keyframes; }
+	/** Sets the floor frame from a plane estimate on given world points (e.g. SLAM map points).
+	 * The "up" hint is insertionOptions.floorUpHint, or -y of the camera if that is zero; the
+	 * floor frame's origin is the camera footprint and its x axis the camera heading. */
+	bool estimateFloorFromPoints(
+		const std::vector<mrpt::math::TPoint3D>& points_world,
+		const mrpt::poses::CPose3D& T_world_cam);
+	/** True once the floor frame is known (always when estimateFloorFromDepth is false). */
+	bool floorKnown() const { return !insertionOptions.estimateFloorFromDepth || m_floorEstimated; }
+	/** @} */
+
+	/** @name Cell access (cell indices; (0,0) is the cell at (xMin, yMin))
+	 * @{ */
+	double resolution() const { return m_resolution; }
+	double xMin() const { return m_xMin; }
+	double yMin() const { return m_yMin; }
+	double xMax() const { return m_xMin + m_sizeX * m_resolution; }
+	double yMax() const { return m_yMin + m_sizeY * m_resolution; }
+	int sizeX() const { return m_sizeX; }
+	int sizeY() const { return m_sizeY; }
+	int x2idx(double x) const { return static_cast<int>(std::floor((x - m_xMin) / m_resolution)); }
+	int y2idx(double y) const { return static_cast<int>(std::floor((y - m_yMin) / m_resolution)); }
+	double idx2x(int cx) const { return m_xMin + (cx + 0.5) * m_resolution; }
+	double idx2y(int cy) const { return m_yMin + (cy + 0.5) * m_resolution; }
+	bool inside(int cx, int cy) const { return cx >= 0 && cy >= 0 && cx < m_sizeX && cy < m_sizeY; }
+	/** Log-odds of a cell (l0 outside the grid). */
+	float logOdds(int cx, int cy) const;
+	/** Occupancy probability of a cell (pPrior outside the grid). */
+	double occupancy(int cx, int cy) const;
+	/** Tri-state by the insertion thresholds. */
+	CellState cellState(int cx, int cy) const;
+	/** Tri-state at a floor-frame position [m]. */
+	CellState stateAt(double x, double y) const { return cellState(x2idx(x), y2idx(y)); }
+	/** Number of cells in each state: {unknown, free, occupied}. */
+	std::array<size_t, 3> countStates() const;
+	/** The floor frame in use: the estimate when estimateFloorFromDepth, else T_world_floor. */
+	const mrpt::poses::CPose3D& floorPose() const
+	{
+		return insertionOptions.estimateFloorFromDepth ? m_T_world_floorEstimate
+													   : insertionOptions.T_world_floor;
+	}
+	/** @} */
+
+	/** @name Exports
+	 * @{ */
+	/** ROS map_server pair: `<yamlPath>` and the .pgm next to it (same stem). Trinary:
+	 * occupied 0, free 254, unknown 205; origin = (xMin, yMin, 0) in the floor frame. Throws on
+	 * I/O errors. */
+	void saveAsRosMapServer(const std::string& yamlPath) const;
+	/** Grey PNG (or any format by extension): 255 * (1 - p), i.e. black = occupied; y up. */
+	void saveAsImage(const std::string& file) const;
+	/** The same grid as MRPT's COccupancyGridMap2D (its cells store p(free) = 1 - p). */
+	mrpt::maps::COccupancyGridMap2D toOccupancyGridMap2D() const;
+	/** @} */
+
+	// CMetricMap
+	bool isEmpty() const override;
+	void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
+	void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
+	std::string asString() const override;
+
+   protected:
+	void internal_clear() override;
+	bool internal_insertObservation(
+		const mrpt::obs::CObservation& obs,
+		const std::optional<const mrpt::poses::CPose3D>& robotPose = std::nullopt) override;
+	double internal_computeObservationLikelihood(
+		const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const override;
+	bool internal_canComputeObservationLikelihood(
+		const mrpt::obs::CObservation& obs) const override;
+
+   private:
+	double m_resolution{0.05};
+	double m_xMin{0}, m_yMin{0};
+	int m_sizeX{0}, m_sizeY{0};
+	std::vector<float> m_logOdds;  ///< row-major, index cx + cy * m_sizeX
+	mrpt::poses::CPose3D m_T_world_floorEstimate;  ///< RANSAC estimate, if m_floorEstimated
+	bool m_floorEstimated{false};
+	std::map<uint64_t, KeyframeRays> m_keyframes;
+	uint64_t m_nextAutoKeyframeId{1ULL << 62};  ///< ids for insertObservation() inputs
+	double m_lastRebuildSeconds{0};
+	/** Per-insertion scratch: the one update each cell gets from the current keyframe. */
+	std::vector<float> m_scratch;
+	std::vector<int> m_touched;
+
+	void resetGeometry(const TCreationOptions& c);
+	/** Grows the grid (keeping contents) to cover [x0,x1]x[y0,y1] of the floor frame. */
+	void growToContain(double x0, double x1, double y0, double y1);
+	/** Insert one keyframe's rays (camera frame) at a pose: classify, trace, update. */
+	void integrateRays(
+		const mrpt::poses::CPose3D& T_world_cam,
+		const std::vector<mrpt::math::TPoint3Df>& points_cam);
+	/** Depth image -> one representative point per endpoint cell (camera frame). */
+	std::vector<mrpt::math::TPoint3Df> reduceDepth(
+		const mrpt::poses::CPose3D& T_world_cam,
+		const mrpt::obs::CObservation3DRangeScan& obs) const;
+	bool ensureFloorFromDepth(
+		const mrpt::poses::CPose3D& T_world_cam, const mrpt::obs::CObservation3DRangeScan& obs);
+
+   public:
+	MAP_DEFINITION_START(CISMOccupancyGrid2D)
+	TCreationOptions creationOpts;
+	TInsertionOptions insertionOpts;
+	TLikelihoodOptions likelihoodOpts;
+	MAP_DEFINITION_END(CISMOccupancyGrid2D)
+};
+
+/** Depth pixels of an observation as points in the optical camera frame (depth camera
+ * intrinsics, distortion ignored), every `decimation`-th row and column, invalid skipped. */
+std::vector<mrpt::math::TPoint3Df> depthToCameraPoints(
+	const mrpt::obs::CObservation3DRangeScan& obs, int decimation);
+
+}  // namespace keygrid

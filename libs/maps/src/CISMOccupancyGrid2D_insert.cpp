@@ -1,0 +1,387 @@
+/** \file CISMOccupancyGrid2D_insert.cpp
+ * Inserting keyframes (sparse points or dense depth) with the practical ISM, floor estimation,
+ * rebuild after loop closure, and the observation likelihood.
+ */
+#include <keygrid/core/FrameConventions.h>
+#include <keygrid/maps/CISMOccupancyGrid2D.h>
+#include <keygrid/maps/GridRayTraversal.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+using namespace keygrid;
+using mrpt::math::TPoint3D;
+using mrpt::math::TPoint3Df;
+using mrpt::poses::CPose3D;
+
+namespace
+{
+/** Rotation + translation of T_floor_cam as plain floats for the inner loops. */
+struct RigidF
+{
+	float R[9];
+	float t[3];
+	explicit RigidF(const CPose3D& T)
+	{
+		const auto& M = T.getRotationMatrix();
+		for (int i = 0; i < 3; i++)
+			for (int j = 0; j < 3; j++) R[3 * i + j] = static_cast<float>(M(i, j));
+		t[0] = static_cast<float>(T.x());
+		t[1] = static_cast<float>(T.y());
+		t[2] = static_cast<float>(T.z());
+	}
+	void apply(float x, float y, float z, float& ox, float& oy, float& oz) const
+	{
+		ox = R[0] * x + R[1] * y + R[2] * z + t[0];
+		oy = R[3] * x + R[4] * y + R[5] * z + t[1];
+		oz = R[6] * x + R[7] * y + R[8] * z + t[2];
+	}
+};
+
+/** Combines two updates of one cell from the same keyframe: occupied evidence wins (as in
+ * OctoMap), otherwise the most confident free update. Each cell thus changes once per keyframe,
+ * whatever the number of rays crossing it. */
+inline float combine(float cur, float inc)
+{
+	if (cur > 0.0f || inc > 0.0f) return std::max(cur, inc);
+	return std::min(cur, inc);
+}
+}  // namespace
+
+std::vector<TPoint3Df> keygrid::depthToCameraPoints(
+	const mrpt::obs::CObservation3DRangeScan& obs, int decimation)
+{
+	std::vector<TPoint3Df> out;
+	if (!obs.hasRangeImage) return out;
+	const int rows = static_cast<int>(obs.rangeImage.rows());
+	const int cols = static_cast<int>(obs.rangeImage.cols());
+	const auto& K = obs.cameraParams;
+	const float fx = static_cast<float>(K.fx()), fy = static_cast<float>(K.fy());
+	const float cx = static_cast<float>(K.cx()), cy = static_cast<float>(K.cy());
+	const float units = obs.rangeUnits;
+	out.reserve(static_cast<size_t>(rows / decimation + 1) * static_cast<size_t>(cols / decimation + 1));
+	for (int r = 0; r < rows; r += decimation)
+	{
+		const float yn = (static_cast<float>(r) - cy) / fy;
+		for (int c = 0; c < cols; c += decimation)
+		{
+			const uint16_t raw = obs.rangeImage(r, c);
+			if (raw == 0) continue;
+			const float xn = (static_cast<float>(c) - cx) / fx;
+			float z = raw * units;
+			if (!obs.range_is_depth) z /= std::sqrt(1.0f + xn * xn + yn * yn);
+			out.emplace_back(xn * z, yn * z, z);
+		}
+	}
+	return out;
+}
+
+void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::vector<TPoint3Df>& pts)
+{
+	const TInsertionOptions& o = insertionOptions;
+	const maps::IsmShape shape = o.ismShape(m_resolution);
+	const double l0 = maps::logit(o.pPrior);
+	const float lFree = static_cast<float>(maps::logit(o.pFree) - l0);
+	const CPose3D T_floor_cam = T_world_cam - floorPose();  // a - b = inv(b) (+) a
+	const RigidF T(T_floor_cam);
+	const float sx = T.t[0], sy = T.t[1];
+	const double halfL = 0.5 * shape.bandWidth;
+	const float maxRange2 = static_cast<float>(o.maxRange * o.maxRange);
+
+	// 1) classify and collect the rays in the floor frame, with their bounding box.
+	struct Ray
+	{
+		float ex, ey;  // endpoint footprint (floor frame) [m]
+		float range;  // horizontal camera -> endpoint distance [m]
+		float sigma;  // range noise [m]
+		bool obstacle;
+	};
+	std::vector<Ray> rays;
+	rays.reserve(pts.size());
+	double bx0 = sx, bx1 = sx, by0 = sy, by1 = sy;
+	for (const auto& p : pts)
+	{
+		float fx, fy, fz;
+		T.apply(p.x, p.y, p.z, fx, fy, fz);
+		const bool obstacle = fz >= o.obstacleMinHeight && fz <= o.obstacleMaxHeight;
+		const bool floor = std::abs(fz) <= o.floorTolerance;
+		if (!obstacle && !floor) continue;
+		const float dx = fx - sx, dy = fy - sy;
+		const float d2 = dx * dx + dy * dy;
+		if (!(d2 <= maxRange2) || d2 < 1e-12f) continue;  // also drops NaN points
+		Ray r;
+		r.ex = fx;
+		r.ey = fy;
+		r.range = std::sqrt(d2);
+		// Depth along the optical axis drives the noise; the ray is (nearly) horizontal.
+		r.sigma = static_cast<float>(maps::rangeSigma(o.rangeNoise, o.sigmaConstant, p.z));
+		r.obstacle = obstacle;
+		// Obstacle rays continue behind the endpoint while the ISM differs from the prior.
+		const double reach = obstacle ? r.range + halfL + 8.0 * r.sigma : r.range;
+		const double ux = sx + dx / r.range * reach, uy = sy + dy / r.range * reach;
+		bx0 = std::min(bx0, ux);
+		bx1 = std::max(bx1, ux);
+		by0 = std::min(by0, uy);
+		by1 = std::max(by1, uy);
+		rays.push_back(r);
+	}
+	if (rays.empty()) return;
+	growToContain(bx0 - m_resolution, bx1 + m_resolution, by0 - m_resolution, by1 + m_resolution);
+
+	// 2) trace: every visited cell gets one combined increment in m_scratch.
+	const double res = m_resolution;
+	auto toCellX = [&](double x) { return (x - m_xMin) / res - 0.5; };  // cell centre at integer
+	auto toCellY = [&](double y) { return (y - m_yMin) / res - 0.5; };
+	const double csx = toCellX(sx), csy = toCellY(sy);
+	auto touch = [&](int cx, int cy, float inc) {
+		if (!inside(cx, cy) || inc == 0.0f) return;
+		const size_t idx = static_cast<size_t>(cx) + static_cast<size_t>(cy) * m_sizeX;
+		float& s = m_scratch[idx];
+		if (s == 0.0f)
+		{
+			m_touched.push_back(static_cast<int>(idx));
+			s = inc;
+		}
+		else
+			s = combine(s, inc);
+	};
+	// Log-odds increment of the practical ISM at distance r; exact-free / prior far from the band.
+	auto ismIncrement = [&](double r, const Ray& ray) -> float {
+		if (!ray.obstacle) return r <= ray.range ? lFree : 0.0f;
+		const double cut = 8.0 * ray.sigma;
+		if (r < ray.range - halfL - cut) return lFree;
+		if (r > ray.range + halfL + cut) return 0.0f;
+		return static_cast<float>(maps::logit(maps::practicalIsm(r, ray.range, ray.sigma, shape)) - l0);
+	};
+
+	for (const Ray& ray : rays)
+	{
+		const double reach = ray.obstacle ? ray.range + halfL + 8.0 * ray.sigma : ray.range;
+		const double k = reach / ray.range;
+		const double ex = sx + (ray.ex - sx) * k, ey = sy + (ray.ey - sy) * k;
+		if (o.rayTraversal == RayTraversal::Bresenham)
+		{
+			const int c0x = static_cast<int>(std::lround(csx)), c0y = static_cast<int>(std::lround(csy));
+			const int c1x = static_cast<int>(std::lround(toCellX(ex)));
+			const int c1y = static_cast<int>(std::lround(toCellY(ey)));
+			maps::bresenhamLine(c0x, c0y, c1x, c1y, [&](int cx, int cy) {
+				const double dx = idx2x(cx) - sx, dy = idx2y(cy) - sy;
+				const double r = std::sqrt(dx * dx + dy * dy);
+				touch(cx, cy, ismIncrement(r, ray));
+			});
+		}
+		else
+		{
+			maps::wuLine(csx, csy, toCellX(ex), toCellY(ey), [&](int cx, int cy, float w, double px, double py) {
+				const double r = res * std::sqrt((px - csx) * (px - csx) + (py - csy) * (py - csy));
+				touch(cx, cy, w * ismIncrement(r, ray));
+			});
+		}
+	}
+
+	// 3) apply l_t = l_{t-1} + ISM - l0 once per touched cell, clamped.
+	const float lo = static_cast<float>(o.logOddsMin - l0), hi = static_cast<float>(o.logOddsMax - l0);
+	for (int idx : m_touched)
+	{
+		float& l = m_logOdds[static_cast<size_t>(idx)];
+		l = std::clamp(l + m_scratch[static_cast<size_t>(idx)], lo, hi);
+		m_scratch[static_cast<size_t>(idx)] = 0.0f;
+	}
+	m_touched.clear();
+}
+
+bool CISMOccupancyGrid2D::insertKeyframePoints(
+	uint64_t keyframeId, const CPose3D& T_world_cam, const std::vector<TPoint3D>& points_world)
+{
+	KeyframeRays kf;
+	kf.T_world_cam = T_world_cam;
+	kf.points_cam.reserve(points_world.size());
+	for (const auto& p : points_world)
+	{
+		const TPoint3D pc = T_world_cam.inverseComposePoint(p);
+		kf.points_cam.emplace_back(static_cast<float>(pc.x), static_cast<float>(pc.y), static_cast<float>(pc.z));
+	}
+	m_keyframes[keyframeId] = kf;
+	if (!floorKnown()) return false;
+	integrateRays(kf.T_world_cam, m_keyframes[keyframeId].points_cam);
+	return true;
+}
+
+std::vector<TPoint3Df> CISMOccupancyGrid2D::reduceDepth(
+	const CPose3D& T_world_cam, const mrpt::obs::CObservation3DRangeScan& obs) const
+{
+	const TInsertionOptions& o = insertionOptions;
+	std::vector<TPoint3Df> out;
+	if (!obs.hasRangeImage) return out;
+	const RigidF T(T_world_cam - floorPose());
+	// A local accumulator of endpoint cells centred on the camera footprint, +- maxRange.
+	const int half = static_cast<int>(std::ceil(o.maxRange / m_resolution)) + 1;
+	const int n = 2 * half + 1;
+	const float inv = static_cast<float>(1.0 / m_resolution);
+	const float ox = T.t[0] - static_cast<float>(half * m_resolution);
+	const float oy = T.t[1] - static_cast<float>(half * m_resolution);
+	struct Acc
+	{
+		int obstacles{0};
+		float bestRange{std::numeric_limits<float>::max()};
+		TPoint3Df obstacle;
+		bool hasFloor{false};
+		TPoint3Df floor;
+	};
+	std::vector<Acc> acc(static_cast<size_t>(n) * n);
+
+	const int rows = static_cast<int>(obs.rangeImage.rows());
+	const int cols = static_cast<int>(obs.rangeImage.cols());
+	const auto& K = obs.cameraParams;
+	const float fx = static_cast<float>(K.fx()), fy = static_cast<float>(K.fy());
+	const float cx = static_cast<float>(K.cx()), cy = static_cast<float>(K.cy());
+	const float units = obs.rangeUnits;
+	const float hMin = static_cast<float>(o.obstacleMinHeight), hMax = static_cast<float>(o.obstacleMaxHeight);
+	const float fTol = static_cast<float>(o.floorTolerance);
+	const float maxR2 = static_cast<float>(o.maxRange * o.maxRange);
+	std::vector<float> xn(static_cast<size_t>(cols));
+	for (int c = 0; c < cols; c++) xn[static_cast<size_t>(c)] = (static_cast<float>(c) - cx) / fx;
+	const int dec = o.depthDecimation;
+	for (int r = 0; r < rows; r += dec)
+	{
+		const float yn = (static_cast<float>(r) - cy) / fy;
+		for (int c = 0; c < cols; c += dec)
+		{
+			const uint16_t raw = obs.rangeImage(r, c);
+			if (raw == 0) continue;
+			float z = raw * units;
+			const float x = xn[static_cast<size_t>(c)];
+			if (!obs.range_is_depth) z /= std::sqrt(1.0f + x * x + yn * yn);
+			const float pcx = x * z, pcy = yn * z;
+			float px, py, pz;
+			T.apply(pcx, pcy, z, px, py, pz);
+			const bool obstacle = pz >= hMin && pz <= hMax;
+			const bool floor = pz >= -fTol && pz <= fTol;
+			if (!obstacle && !floor) continue;
+			const float dx = px - T.t[0], dy = py - T.t[1];
+			const float d2 = dx * dx + dy * dy;
+			if (!(d2 <= maxR2)) continue;
+			const int ix = static_cast<int>((px - ox) * inv), iy = static_cast<int>((py - oy) * inv);
+			if (ix < 0 || iy < 0 || ix >= n || iy >= n) continue;
+			Acc& a = acc[static_cast<size_t>(ix) + static_cast<size_t>(iy) * n];
+			if (obstacle)
+			{
+				a.obstacles++;
+				if (d2 < a.bestRange)
+				{
+					a.bestRange = d2;
+					a.obstacle = TPoint3Df(pcx, pcy, z);
+				}
+			}
+			else if (!a.hasFloor)
+			{
+				a.hasFloor = true;
+				a.floor = TPoint3Df(pcx, pcy, z);
+			}
+		}
+	}
+	for (const Acc& a : acc)
+	{
+		if (a.obstacles >= o.minPointsPerCell) out.push_back(a.obstacle);
+		if (a.hasFloor) out.push_back(a.floor);
+	}
+	return out;
+}
+
+bool CISMOccupancyGrid2D::ensureFloorFromDepth(
+	const CPose3D& T_world_cam, const mrpt::obs::CObservation3DRangeScan& obs)
+{
+	if (floorKnown()) return true;
+	const auto pts_cam = depthToCameraPoints(obs, 4);
+	std::vector<TPoint3D> pts_world;
+	pts_world.reserve(pts_cam.size());
+	for (const auto& p : pts_cam) pts_world.push_back(T_world_cam.composePoint(TPoint3D(p.x, p.y, p.z)));
+	return estimateFloorFromPoints(pts_world, T_world_cam);
+}
+
+bool CISMOccupancyGrid2D::estimateFloorFromPoints(
+	const std::vector<TPoint3D>& points_world, const CPose3D& T_world_cam)
+{
+	const auto& hint = insertionOptions.floorUpHint;
+	const auto up = hint.norm() > 0 ? hint : T_world_cam.rotateVector(mrpt::math::TVector3D(0, -1, 0));
+	const auto fwd = T_world_cam.rotateVector(mrpt::math::TVector3D(0, 0, 1));
+	const auto cam = T_world_cam.translation();
+	const auto plane = maps::estimateFloorPlane(points_world, up, cam, insertionOptions.floorRansac);
+	if (!plane) return false;
+	m_T_world_floorEstimate = maps::floorPoseFromPlane(*plane, cam, fwd);
+	m_floorEstimated = true;
+	return true;
+}
+
+bool CISMOccupancyGrid2D::insertKeyframeDepth(
+	uint64_t keyframeId, const CPose3D& T_world_cam, const mrpt::obs::CObservation3DRangeScan& obs)
+{
+	if (!obs.hasRangeImage) return false;
+	if (!ensureFloorFromDepth(T_world_cam, obs)) return false;
+	KeyframeRays kf;
+	kf.T_world_cam = T_world_cam;
+	kf.points_cam = reduceDepth(T_world_cam, obs);
+	integrateRays(kf.T_world_cam, kf.points_cam);
+	m_keyframes[keyframeId] = std::move(kf);
+	return true;
+}
+
+bool CISMOccupancyGrid2D::internal_insertObservation(
+	const mrpt::obs::CObservation& obs, const std::optional<const CPose3D>& robotPose)
+{
+	const auto* o = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
+	if (!o) return false;
+	o->load();  // external range images
+	const CPose3D T_world_robot = robotPose ? *robotPose : CPose3D();
+	const CPose3D T_world_cam = core::cameraPoseFromSensorPose(T_world_robot + o->sensorPose);
+	return insertKeyframeDepth(m_nextAutoKeyframeId++, T_world_cam, *o);
+}
+
+double CISMOccupancyGrid2D::applyTrajectoryCorrection(const std::map<uint64_t, CPose3D>& newPoses)
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	for (const auto& [id, pose] : newPoses)
+	{
+		auto it = m_keyframes.find(id);
+		if (it == m_keyframes.end())
+			throw std::out_of_range(
+				"applyTrajectoryCorrection: keyframe " + std::to_string(id) + " is not in the map");
+		it->second.T_world_cam = pose;
+	}
+	std::fill(m_logOdds.begin(), m_logOdds.end(), 0.0f);
+	for (const auto& [id, kf] : m_keyframes) integrateRays(kf.T_world_cam, kf.points_cam);
+	m_lastRebuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+	return m_lastRebuildSeconds;
+}
+
+bool CISMOccupancyGrid2D::internal_canComputeObservationLikelihood(const mrpt::obs::CObservation& obs) const
+{
+	const auto* o = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
+	return o != nullptr && o->hasRangeImage;
+}
+
+/* Likelihood of a depth image: the obstacle-band points, each independently, hit an occupied
+ * cell with probability p(cell), mixed with an outlier floor:
+ *     log L = sum_i log(eps + (1 - eps) p(cell_i)),   eps = outlierProbability. */
+double CISMOccupancyGrid2D::internal_computeObservationLikelihood(
+	const mrpt::obs::CObservation& obs, const CPose3D& takenFrom) const
+{
+	const auto* o = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
+	if (!o || !o->hasRangeImage) return 0.0;
+	o->load();
+	const CPose3D T_world_cam = core::cameraPoseFromSensorPose(takenFrom + o->sensorPose);
+	const RigidF T(T_world_cam - floorPose());
+	const double eps = likelihoodOptions.outlierProbability;
+	double logLik = 0;
+	for (const auto& p : depthToCameraPoints(*o, likelihoodOptions.decimation))
+	{
+		float fx, fy, fz;
+		T.apply(p.x, p.y, p.z, fx, fy, fz);
+		if (fz < insertionOptions.obstacleMinHeight || fz > insertionOptions.obstacleMaxHeight) continue;
+		logLik += std::log(eps + (1.0 - eps) * occupancy(x2idx(fx), y2idx(fy)));
+	}
+	return logLik;
+}

@@ -1,0 +1,480 @@
+#include "detail/Grid3DConfig.h"
+#include "detail/Grid3DParallel.h"
+
+#include <keygrid/maps/Dda.h>
+#include <keygrid/maps/DepthFrameIntegrator.h>
+#include <mrpt/config/CConfigFileBase.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <climits>
+#include <cstring>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace keygrid
+{
+// ---------------------------------------------------------------- options
+void DepthIntegrationOptions::loadFromConfigFile(
+	const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	using detail::readNumber;
+	maxRange = readNumber(c, s, "maxRange", maxRange);
+	minRange = readNumber(c, s, "minRange", minRange);
+	const double dec = readNumber(c, s, "pixelDecimation", pixelDecimation);
+	detail::require(dec >= 1 && dec == std::floor(dec), "pixelDecimation", dec, "an integer >= 1");
+	pixelDecimation = static_cast<unsigned>(dec);
+	const double th = readNumber(c, s, "threads", threads);
+	detail::require(th >= 0 && th == std::floor(th), "threads", th, "an integer >= 0");
+	threads = static_cast<unsigned>(th);
+	logOddsHit = static_cast<float>(readNumber(c, s, "logOddsHit", logOddsHit));
+	logOddsMiss = static_cast<float>(readNumber(c, s, "logOddsMiss", logOddsMiss));
+	logOddsMin = static_cast<float>(readNumber(c, s, "logOddsMin", logOddsMin));
+	logOddsMax = static_cast<float>(readNumber(c, s, "logOddsMax", logOddsMax));
+	maxDenseMarkVoxels = readNumber(c, s, "maxDenseMarkVoxels", maxDenseMarkVoxels);
+	discretizeEndpoints = detail::readBool(c, s, "discretizeEndpoints", discretizeEndpoints);
+	validate();
+}
+
+void DepthIntegrationOptions::saveToConfigFile(
+	mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	detail::writeNumber(c, s, "maxRange", maxRange);
+	detail::writeNumber(c, s, "minRange", minRange);
+	detail::writeNumber(c, s, "pixelDecimation", pixelDecimation);
+	detail::writeNumber(c, s, "threads", threads);
+	detail::writeNumber(c, s, "logOddsHit", logOddsHit);
+	detail::writeNumber(c, s, "logOddsMiss", logOddsMiss);
+	detail::writeNumber(c, s, "logOddsMin", logOddsMin);
+	detail::writeNumber(c, s, "logOddsMax", logOddsMax);
+	detail::writeNumber(c, s, "maxDenseMarkVoxels", maxDenseMarkVoxels);
+	detail::writeBool(c, s, "discretizeEndpoints", discretizeEndpoints);
+}
+
+void DepthIntegrationOptions::validate() const
+{
+	using detail::require;
+	require(maxRange > 0, "maxRange", maxRange, "> 0 m");
+	require(minRange >= 0 && minRange < maxRange, "minRange", minRange, ">= 0 and < maxRange");
+	require(pixelDecimation >= 1, "pixelDecimation", pixelDecimation, ">= 1");
+	require(logOddsHit > 0, "logOddsHit", logOddsHit, "> 0");
+	require(logOddsMiss < 0, "logOddsMiss", logOddsMiss, "< 0");
+	require(logOddsMin < 0, "logOddsMin", logOddsMin, "< 0");
+	require(logOddsMax > 0, "logOddsMax", logOddsMax, "> 0");
+	require(maxDenseMarkVoxels >= 512, "maxDenseMarkVoxels", maxDenseMarkVoxels, ">= 512");
+}
+
+// ---------------------------------------------------------------- ray table
+void PixelRayTable::update(const core::RgbdCamera& cam)
+{
+	const bool same = m_valid && cam.width == m_cam.width && cam.height == m_cam.height &&
+		cam.fx == m_cam.fx && cam.fy == m_cam.fy && cam.cx == m_cam.cx && cam.cy == m_cam.cy &&
+		cam.dist == m_cam.dist;
+	if (same) return;
+	m_cam = cam;
+	m_w = cam.width;
+	m_h = cam.height;
+	m_xy.assign(2 * static_cast<std::size_t>(m_w) * m_h, 0.0f);
+	if (!cam.hasDistortion())
+	{
+		for (unsigned v = 0; v < m_h; ++v)
+			for (unsigned u = 0; u < m_w; ++u)
+			{
+				float* p = &m_xy[2 * (static_cast<std::size_t>(v) * m_w + u)];
+				p[0] = static_cast<float>((u - cam.cx) / cam.fx);
+				p[1] = static_cast<float>((v - cam.cy) / cam.fy);
+			}
+	}
+	else
+	{
+		cv::Mat K = (cv::Mat_<double>(3, 3) << cam.fx, 0, cam.cx, 0, cam.fy, cam.cy, 0, 0, 1);
+		cv::Mat D(1, 5, CV_64F);
+		for (int i = 0; i < 5; ++i) D.at<double>(i) = cam.dist[i];
+		std::vector<cv::Point2f> px, und;
+		px.reserve(static_cast<std::size_t>(m_w) * m_h);
+		for (unsigned v = 0; v < m_h; ++v)
+			for (unsigned u = 0; u < m_w; ++u) px.emplace_back(float(u), float(v));
+		cv::undistortPoints(px, und, K, D);
+		for (std::size_t i = 0; i < und.size(); ++i)
+		{
+			m_xy[2 * i] = und[i].x;
+			m_xy[2 * i + 1] = und[i].y;
+		}
+	}
+	m_valid = true;
+}
+
+// ---------------------------------------------------------------- integrator
+DepthFrameIntegrator::DepthFrameIntegrator(const DepthIntegrationOptions& opts) : m_opts(opts)
+{
+	m_opts.validate();
+}
+
+FrameVoxelUpdates DepthFrameIntegrator::castFrame(
+	const cv::Mat& depth, const core::RgbdCamera& cam, const mrpt::poses::CPose3D& T_world_cam,
+	double resolution)
+{
+	if (depth.type() != CV_32FC1)
+		throw std::invalid_argument("castFrame: depth must be CV_32FC1 [m]");
+	if (depth.cols != static_cast<int>(cam.width) || depth.rows != static_cast<int>(cam.height))
+		throw std::invalid_argument(
+			"castFrame: depth is " + std::to_string(depth.cols) + "x" +
+			std::to_string(depth.rows) + " but the camera is " + std::to_string(cam.width) + "x" +
+			std::to_string(cam.height));
+	m_rays.update(cam);
+
+	const unsigned dec = m_opts.pixelDecimation;
+	const unsigned nu = (cam.width + dec - 1) / dec, nv = (cam.height + dec - 1) / dec;
+	const std::size_t n = static_cast<std::size_t>(nu) * nv;
+	const bool disc = m_opts.discretizeEndpoints;
+	if (!disc)
+	{
+		m_flags.resize(n);
+		m_ends.resize(n);
+	}
+
+	const auto Rm = T_world_cam.getRotationMatrix();
+	const double R[3][3] = {{Rm(0, 0), Rm(0, 1), Rm(0, 2)}, {Rm(1, 0), Rm(1, 1), Rm(1, 2)},
+		{Rm(2, 0), Rm(2, 1), Rm(2, 2)}};
+	const mrpt::math::TPoint3D origin(T_world_cam.x(), T_world_cam.y(), T_world_cam.z());
+	const double maxR = m_opts.maxRange, minR2 = m_opts.minRange * m_opts.minRange,
+				 maxR2 = maxR * maxR;
+	constexpr float kInfF = std::numeric_limits<float>::infinity();
+	const double inv = 1.0 / resolution;
+	const unsigned threads = detail::resolveThreads(m_opts.threads);
+	const VoxelIndex o{floorToInt(origin.x * inv), floorToInt(origin.y * inv), floorToInt(origin.z * inv)};
+	std::vector<Extent> ext(threads, Extent{o, o, 0});
+	m_runs.resize(threads);
+	for (auto& r : m_runs) r.clear();
+
+	// Back-projection, end voxels and their bounding box in one pass over the pixels.
+	detail::parallelChunks(nv, threads, [&](std::size_t r0, std::size_t r1, unsigned t) {
+		Extent e{o, o, 0};
+		std::vector<EndVoxel>& runs = m_runs[t];
+		VoxelIndex prev{INT32_MIN, 0, 0};
+		uint8_t prevFlag = 0;
+		for (std::size_t r = r0; r < r1; ++r)
+		{
+			const unsigned v = static_cast<unsigned>(r) * dec;
+			const float* drow = depth.ptr<float>(static_cast<int>(v));
+			const float* xy = m_rays.row(v);
+			for (unsigned c = 0; c < nu; ++c)
+			{
+				const std::size_t i = r * nu + c;
+				if (!disc) m_flags[i] = 0;
+				const unsigned u = c * dec;
+				const float d = drow[u];
+				if (!(d > 0.0f && d < kInfF)) continue;  // 0, negative, NaN and inf are invalid
+				double x = xy[2 * u] * d, y = xy[2 * u + 1] * d, z = d;
+				const double range2 = x * x + y * y + z * z;  // compare squares: no sqrt per pixel
+				if (range2 < minR2) continue;
+				uint8_t f = 2;
+				if (range2 > maxR2)
+				{
+					const double s = maxR / std::sqrt(range2);
+					x *= s, y *= s, z *= s;
+					f = 1;
+				}
+				++e.rays;
+				double w[3] = {R[0][0] * x + R[0][1] * y + R[0][2] * z + origin.x,
+					R[1][0] * x + R[1][1] * y + R[1][2] * z + origin.y,
+					R[2][0] * x + R[2][1] * y + R[2][2] * z + origin.z};
+				if (!disc)
+				{
+					// Per-pixel rays end at the float point: take its voxel from the same value.
+					m_flags[i] = f;
+					m_ends[i] = mrpt::math::TPoint3Df(float(w[0]), float(w[1]), float(w[2]));
+					w[0] = m_ends[i].x, w[1] = m_ends[i].y, w[2] = m_ends[i].z;
+				}
+				const VoxelIndex vx{floorToInt(w[0] * inv), floorToInt(w[1] * inv), floorToInt(w[2] * inv)};
+				if (disc)
+				{
+					// Runs of pixels ending in the same voxel are recorded once.
+					if (vx == prev && f == prevFlag) continue;
+					prev = vx;
+					prevFlag = f;
+					runs.push_back({vx, f == 2});
+				}
+				e.add(vx);
+			}
+		}
+		ext[t] = e;
+	});
+	Extent all{o, o, 0};
+	for (const auto& e : ext) all.merge(e);
+	return castRays(origin, n, all, resolution);
+}
+
+FrameVoxelUpdates DepthFrameIntegrator::castPoints(
+	const mrpt::math::TPoint3D& o, const std::vector<mrpt::math::TPoint3Df>& pts,
+	double resolution)
+{
+	const bool disc = m_opts.discretizeEndpoints;
+	const std::size_t n = pts.size();
+	m_flags.assign(n, 0);
+	m_ends.resize(n);
+	m_runs.assign(1, {});
+	const double inv = 1.0 / resolution;
+	auto vox = [inv](double x, double y, double z) {
+		return VoxelIndex{floorToInt(x * inv), floorToInt(y * inv), floorToInt(z * inv)};
+	};
+	Extent all{vox(o.x, o.y, o.z), vox(o.x, o.y, o.z), 0};
+	for (std::size_t i = 0; i < n; ++i)
+	{
+		const double dx = pts[i].x - o.x, dy = pts[i].y - o.y, dz = pts[i].z - o.z;
+		const double range = std::sqrt(dx * dx + dy * dy + dz * dz);
+		if (!std::isfinite(range) || range < m_opts.minRange) continue;
+		mrpt::math::TPoint3Df p = pts[i];
+		m_flags[i] = 2;
+		if (range > m_opts.maxRange)
+		{
+			const double s = m_opts.maxRange / range;
+			p = mrpt::math::TPoint3Df(static_cast<float>(o.x + dx * s),
+				static_cast<float>(o.y + dy * s), static_cast<float>(o.z + dz * s));
+			m_flags[i] = 1;
+		}
+		const VoxelIndex v = vox(p.x, p.y, p.z);
+		if (disc) m_runs[0].push_back({v, m_flags[i] == 2});
+		else m_ends[i] = p;
+		all.add(v);
+		++all.rays;
+	}
+	return castRays(o, n, all, resolution);
+}
+
+namespace
+{
+/** Relaxed atomic access to the bytes of the plain scratch buffer (GCC/Clang builtins: the
+ * buffer is reused between frames, which std::atomic<uint8_t>[] would not allow cheaply). */
+inline uint8_t loadMark(const uint8_t& m) { return __atomic_load_n(&m, __ATOMIC_RELAXED); }
+inline uint8_t orMark(uint8_t& m, uint8_t bits)
+{
+	return __atomic_fetch_or(&m, bits, __ATOMIC_RELAXED);
+}
+
+using EndVoxel = DepthFrameIntegrator::EndVoxel;
+/** Sorts by (z, y, x), a hit first, and keeps one entry per voxel (hit wins). */
+void sortUnique(std::vector<EndVoxel>& e)
+{
+	std::sort(e.begin(), e.end(), [](const EndVoxel& a, const EndVoxel& b) {
+		if (a.v.z != b.v.z) return a.v.z < b.v.z;
+		if (a.v.y != b.v.y) return a.v.y < b.v.y;
+		if (a.v.x != b.v.x) return a.v.x < b.v.x;
+		return a.hit > b.hit;
+	});
+	e.erase(std::unique(e.begin(), e.end(),
+				[](const EndVoxel& a, const EndVoxel& b) { return a.v == b.v; }),
+		e.end());
+}
+}  // namespace
+
+FrameVoxelUpdates DepthFrameIntegrator::castRays(
+	const mrpt::math::TPoint3D& origin, std::size_t n, const Extent& extent, double resolution)
+{
+	if (!(resolution > 0)) throw std::invalid_argument("castRays: resolution must be > 0");
+	FrameVoxelUpdates out;
+	out.resolution = resolution;
+	out.rays = extent.rays;
+	if (out.rays == 0) return out;
+	const double inv = 1.0 / resolution;
+	auto vox = [inv](double x, double y, double z) {
+		return VoxelIndex{floorToInt(x * inv), floorToInt(y * inv), floorToInt(z * inv)};
+	};
+	auto centre = [resolution](const VoxelIndex& v) {
+		return mrpt::math::TPoint3D(
+			(v.x + 0.5) * resolution, (v.y + 0.5) * resolution, (v.z + 0.5) * resolution);
+	};
+	const unsigned threads = detail::resolveThreads(m_opts.threads);
+	const std::vector<mrpt::math::TPoint3Df>& ends = m_ends;
+	const std::vector<uint8_t>& flags = m_flags;
+	const VoxelIndex lo = extent.lo, hi = extent.hi;
+
+	const VoxelIndex blo = VoxelBlockGrid::blockOf(lo), bhi = VoxelBlockGrid::blockOf(hi);
+	const std::size_t nbx = std::size_t(bhi.x - blo.x + 1), nby = std::size_t(bhi.y - blo.y + 1),
+					  nbz = std::size_t(bhi.z - blo.z + 1);
+	const double denseVoxels = double(nbx) * double(nby) * double(nbz) * VoxelBlock::kVoxels;
+	std::vector<std::size_t> visits(threads, 0);
+
+	// One ray: free marks strictly before the end voxel, a hit mark on it when it is a hit.
+	auto castOne = [&](const mrpt::math::TPoint3D& end, const VoxelIndex& endVox, bool hit,
+					   auto&& mark) -> std::size_t {
+		const std::size_t nvis = traverseSegment(origin, end, resolution, [&](const VoxelIndex& v) {
+			if (v == endVox) return false;
+			mark(v, FrameVoxelUpdates::kFree);
+			return true;
+		});
+		if (hit) mark(endVox, FrameVoxelUpdates::kHit);
+		return nvis;
+	};
+	auto endOf = [&](std::size_t i) {
+		return mrpt::math::TPoint3D(ends[i].x, ends[i].y, ends[i].z);
+	};
+	constexpr uint8_t kEndHit = 4, kEndCut = 8;  // scratch bits of the discretized mode
+
+	if (denseVoxels <= m_opts.maxDenseMarkVoxels)
+	{
+		// Dense mark volume (reused scratch), block-major so each block's 512 marks are
+		// contiguous.
+		const std::size_t nTotal = static_cast<std::size_t>(denseVoxels);
+		if (m_marks.size() < nTotal) m_marks.resize(nTotal);
+		std::fill(m_marks.begin(), m_marks.begin() + static_cast<std::ptrdiff_t>(nTotal), uint8_t(0));
+		uint8_t* marks = m_marks.data();
+		auto slot = [&](const VoxelIndex& v) -> uint8_t& {
+			const VoxelIndex b = VoxelBlockGrid::blockOf(v);
+			const std::size_t bl = std::size_t(b.x - blo.x) +
+				nbx * (std::size_t(b.y - blo.y) + nby * std::size_t(b.z - blo.z));
+			return marks[bl * VoxelBlock::kVoxels + VoxelBlockGrid::localLinear(v)];
+		};
+		auto markDense = [&](const VoxelIndex& v, uint8_t m) {
+			uint8_t& a = slot(v);
+			// Read first: most voxels near the camera are crossed by many rays.
+			if ((loadMark(a) & m) != m) orMark(a, m);
+		};
+		if (m_opts.discretizeEndpoints)
+		{
+			// Pass 1: the thread that first flags an end voxel records it (the runs already
+			// dropped repeats of the previous pixel's end voxel).
+			std::vector<std::vector<EndVoxel>> found(m_runs.size());
+			detail::parallelChunks(m_runs.size(), threads, [&](std::size_t b, std::size_t e, unsigned) {
+				for (std::size_t t = b; t < e; ++t)
+					for (const EndVoxel& ev : m_runs[t])
+					{
+						const uint8_t bit = ev.hit ? kEndHit : kEndCut;
+						uint8_t& a = slot(ev.v);
+						if (loadMark(a) & bit) continue;
+						if (!(orMark(a, bit) & bit)) found[t].push_back(ev);
+					}
+			});
+			std::vector<EndVoxel> uniq;
+			for (auto& f : found) uniq.insert(uniq.end(), f.begin(), f.end());
+			sortUnique(uniq);
+			out.castRays = uniq.size();
+			// Pass 2: one ray per distinct end voxel, to its centre.
+			detail::parallelChunks(uniq.size(), threads, [&](std::size_t b, std::size_t e, unsigned t) {
+				std::size_t vis = 0;
+				for (std::size_t i = b; i < e; ++i)
+					vis += castOne(centre(uniq[i].v), uniq[i].v, uniq[i].hit, markDense);
+				visits[t] = vis;
+			}, 2000);
+		}
+		else
+		{
+			out.castRays = out.rays;
+			detail::parallelChunks(n, threads, [&](std::size_t b, std::size_t e, unsigned t) {
+				std::size_t vis = 0;
+				for (std::size_t i = b; i < e; ++i)
+					if (flags[i])
+						vis += castOne(endOf(i), vox(ends[i].x, ends[i].y, ends[i].z), flags[i] == 2, markDense);
+				visits[t] = vis;
+			});
+		}
+		// Blocks with any free / hit mark become chunks (the scratch bits 4 and 8 are dropped).
+		constexpr uint64_t kMask = 0x0303030303030303ull;
+		for (std::size_t bz = 0; bz < nbz; ++bz)
+			for (std::size_t by = 0; by < nby; ++by)
+				for (std::size_t bx = 0; bx < nbx; ++bx)
+				{
+					const uint8_t* base = marks + (bx + nbx * (by + nby * bz)) * VoxelBlock::kVoxels;
+					bool any = false;
+					for (int k = 0; k < VoxelBlock::kVoxels && !any; k += 8)
+					{
+						uint64_t w;
+						std::memcpy(&w, base + k, 8);
+						any = (w & kMask) != 0;
+					}
+					if (!any) continue;
+					out.chunks.emplace_back();
+					FrameVoxelUpdates::Chunk& ch = out.chunks.back();
+					ch.block = {blo.x + int32_t(bx), blo.y + int32_t(by), blo.z + int32_t(bz)};
+					for (int k = 0; k < VoxelBlock::kVoxels; ++k) ch.marks[k] = base[k] & 3;
+				}
+	}
+	else
+	{
+		// Sparse path: one thread, a hash map of chunks, sorted afterwards like the dense order.
+		out.sparsePath = true;
+		std::unordered_map<VoxelIndex, std::size_t, VoxelIndexHash> where;
+		auto markSparse = [&](const VoxelIndex& v, uint8_t m) {
+			const VoxelIndex b = VoxelBlockGrid::blockOf(v);
+			auto it = where.find(b);
+			if (it == where.end())
+			{
+				it = where.emplace(b, out.chunks.size()).first;
+				out.chunks.emplace_back();
+				out.chunks.back().block = b;
+			}
+			out.chunks[it->second].marks[VoxelBlockGrid::localLinear(v)] |= m;
+		};
+		std::size_t vis = 0;
+		if (m_opts.discretizeEndpoints)
+		{
+			std::vector<EndVoxel> uniq;
+			for (const auto& r : m_runs) uniq.insert(uniq.end(), r.begin(), r.end());
+			sortUnique(uniq);
+			out.castRays = uniq.size();
+			for (const auto& u : uniq) vis += castOne(centre(u.v), u.v, u.hit, markSparse);
+		}
+		else
+		{
+			out.castRays = out.rays;
+			for (std::size_t i = 0; i < n; ++i)
+				if (flags[i])
+					vis += castOne(endOf(i), vox(ends[i].x, ends[i].y, ends[i].z), flags[i] == 2, markSparse);
+		}
+		visits[0] = vis;
+		std::sort(out.chunks.begin(), out.chunks.end(), [](const auto& a, const auto& b) {
+			if (a.block.z != b.block.z) return a.block.z < b.block.z;
+			if (a.block.y != b.block.y) return a.block.y < b.block.y;
+			return a.block.x < b.block.x;
+		});
+	}
+	for (std::size_t v : visits) out.voxelVisits += v;
+	for (const auto& ch : out.chunks)
+		for (uint8_t m : ch.marks)
+		{
+			if (FrameVoxelUpdates::isHit(m)) ++out.hitVoxels;
+			else if (m) ++out.freeVoxels;
+		}
+	return out;
+}
+
+void DepthFrameIntegrator::apply(
+	VoxelBlockGrid& grid, const FrameVoxelUpdates& upd, double travelled) const
+{
+	if (grid.resolution() != upd.resolution)
+		throw std::invalid_argument(
+			"apply: grid resolution " + std::to_string(grid.resolution()) +
+			" m != update resolution " + std::to_string(upd.resolution) + " m");
+	std::vector<VoxelBlock*> blocks(upd.chunks.size());
+	for (std::size_t i = 0; i < upd.chunks.size(); ++i)
+		blocks[i] = &grid.blockAt(upd.chunks[i].block);
+
+	const float hitL = m_opts.logOddsHit, missL = m_opts.logOddsMiss;
+	const float lo = m_opts.logOddsMin, hi = m_opts.logOddsMax;
+	const float stamp = static_cast<float>(std::max(0.0, travelled));
+	detail::parallelChunks(
+		upd.chunks.size(), detail::resolveThreads(m_opts.threads),
+		[&](std::size_t b, std::size_t e, unsigned) {
+			for (std::size_t i = b; i < e; ++i)
+			{
+				const auto& marks = upd.chunks[i].marks;
+				VoxelBlock& blk = *blocks[i];
+				for (int k = 0; k < VoxelBlock::kVoxels; ++k)
+				{
+					const uint8_t m = marks[k];
+					if (!m) continue;
+					Voxel& vx = blk.voxels[k];
+					const float delta = FrameVoxelUpdates::isHit(m) ? hitL : missL;
+					vx.logOdds = std::min(hi, std::max(lo, vx.logOdds + delta));
+					vx.travelled = stamp;
+				}
+			}
+		},
+		512);
+}
+
+}  // namespace keygrid

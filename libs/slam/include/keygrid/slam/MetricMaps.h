@@ -1,0 +1,68 @@
+#pragma once
+/** \file MetricMaps.h
+ * The metric maps of a run, configured the MRPT way: a CMultiMetricMap built from the INI's
+ * [MappingApplication] section (`ismOccupancyGrid2D_count = 1`,
+ * `MappingApplication_ismOccupancyGrid2D_00_creationOpts`, ...), so keygrid's plugins and MRPT's
+ * own maps (octoMap, occupancyGrid, pointsMap, ...) run side by side.
+ *
+ * keygrid's maps get what they were designed for (the 2D ISM grid a keyframe's map points or
+ * depth, the submapped 3D grid the depth with the travelled distance); other maps get the
+ * keyframe as a CObservation3DRangeScan at its pose.
+ */
+#include <keygrid/core/RgbdCamera.h>
+#include <keygrid/sfm/SparseMap.h>
+#include <mrpt/maps/CMultiMetricMap.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace keygrid::slam
+{
+/** How keyframes feed the maps ([maps] section). */
+struct MapFeedOptions
+{
+	/** Input of the 2D ISM grid: "sparse" (the keyframe's map points, as in the paper) or
+	 * "dense" (its depth image) (Default: sparse) */
+	std::string ism2dInput{"sparse"};
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+};
+
+class MetricMaps
+{
+   public:
+	static constexpr const char* kSection = "MappingApplication";
+
+	/** Creates the maps `cfg` asks for. Throws std::invalid_argument naming any `<name>_count`
+	 * key whose map type is unknown (MRPT itself ignores those silently) or when fewer maps
+	 * were created than requested. No [MappingApplication] section: no maps. */
+	MetricMaps(const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed);
+
+	bool empty() const { return m_maps.maps.empty(); }
+	std::size_t size() const { return m_maps.maps.size(); }
+	const mrpt::maps::CMultiMetricMap& maps() const { return m_maps; }
+
+	/** Inserts keyframe `kf` (pose as now in the map) into every map. `travelled` is the
+	 * camera's path length so far [m]. */
+	void insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId kf, double travelled);
+
+	/** Re-anchors the maps on corrected keyframe poses (kf id -> new T_world_cam): the 2D
+	 * grid is rebuilt from its stored keyframe observations, the 3D grid morphed and merged.
+	 * Returns seconds spent per map name. */
+	std::map<std::string, double> applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses);
+
+	/** Writes each map's outputs into dir (map_2d.{pgm,yaml,png}, map_3d.bt, map_3d.ply, ...);
+	 * returns the file names written. */
+	std::vector<std::string> writeOutputs(const std::string& dir) const;
+	/** JSON array describing each map (class, size, outputs). */
+	std::string summaryJson() const;
+
+   private:
+	mrpt::maps::CMultiMetricMap m_maps;
+	MapFeedOptions m_feed;
+	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> m_insertedPoses;
+};
+
+}  // namespace keygrid::slam

@@ -1,0 +1,219 @@
+#include <keygrid/core/FrameConventions.h>
+#include <keygrid/maps/CISMOccupancyGrid2D.h>
+#include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
+#include <keygrid/slam/MetricMaps.h>
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/maps/TMetricMapTypesRegistry.h>
+
+#include <chrono>
+#include <sstream>
+#include <stdexcept>
+
+namespace keygrid::slam
+{
+void MapFeedOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	ism2dInput = c.read_string(s, "ism2d_input", ism2dInput);
+	if (ism2dInput != "sparse" && ism2dInput != "dense")
+		throw std::invalid_argument("[" + s + "] ism2d_input = '" + ism2dInput + "' (expected sparse or dense)");
+}
+
+void MapFeedOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	c.write(s, "ism2d_input", ism2dInput, 30, 40, "sparse (map points) | dense (depth image)");
+}
+
+namespace
+{
+bool knownMapType(const std::string& name)
+{
+	for (const auto& [registered, ctors] : mrpt::maps::internal::TMetricMapTypesRegistry::Instance().getAllRegistered())
+	{
+		std::stringstream ss(registered);
+		std::string part;
+		while (std::getline(ss, part, ','))
+			if (part == name) return true;
+	}
+	return false;
+}
+
+/** A depth-only observation of a keyframe, for MRPT's own maps. */
+mrpt::obs::CObservation3DRangeScan::Ptr depthObservation(const sfm::KeyFrame& kf)
+{
+	auto obs = mrpt::obs::CObservation3DRangeScan::Create();
+	const auto& cam = kf.features.camera;
+	obs->hasRangeImage = true;
+	obs->range_is_depth = true;
+	obs->rangeUnits = cam.depthUnits;
+	obs->rangeImage.resize(kf.depth.rows, kf.depth.cols);
+	for (int r = 0; r < kf.depth.rows; r++)
+		for (int c = 0; c < kf.depth.cols; c++)
+		{
+			const double q = std::round(kf.depth.at<float>(r, c) / cam.depthUnits);
+			obs->rangeImage(r, c) = q > 0 && q < 65535 ? static_cast<uint16_t>(q) : 0;
+		}
+	obs->cameraParams = cam.toTCamera();
+	obs->cameraParamsIntensity = obs->cameraParams;
+	obs->relativePoseIntensityWRTDepth = core::T_depth_cam();
+	obs->maxRange = 10.0f;
+	return obs;
+}
+}  // namespace
+
+MetricMaps::MetricMaps(const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed) : m_feed(feed)
+{
+	if (!cfg.sectionExists(kSection)) return;
+	std::vector<std::string> keys;
+	cfg.getAllKeys(kSection, keys);
+	std::size_t requested = 0;
+	for (const auto& k : keys)
+	{
+		if (k.size() < 7 || k.substr(k.size() - 6) != "_count") continue;
+		const std::string name = k.substr(0, k.size() - 6);
+		const int n = cfg.read_int(kSection, k, 0);
+		if (n < 0) throw std::invalid_argument(std::string("[") + kSection + "] " + k + " = " + std::to_string(n) + " (must be >= 0)");
+		if (n > 0 && !knownMapType(name))
+			throw std::invalid_argument(
+				std::string("[") + kSection + "] " + k + ": no map type '" + name +
+				"' is registered (typo, or its plugin library is not loaded)");
+		requested += static_cast<std::size_t>(n);
+	}
+	mrpt::maps::TSetOfMetricMapInitializers init;
+	init.loadFromConfigFile(cfg, kSection);
+	m_maps.setListOfMaps(init);
+	if (m_maps.maps.size() != requested)
+		throw std::invalid_argument(
+			std::string("[") + kSection + "] asks for " + std::to_string(requested) + " maps but " +
+			std::to_string(m_maps.maps.size()) + " were created");
+}
+
+void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, double travelled)
+{
+	if (empty()) return;
+	const auto& kf = map.keyframe(id);
+	m_insertedPoses[id] = kf.T_world_cam;
+	mrpt::obs::CObservation3DRangeScan::Ptr obs;  // built on demand
+	for (auto& m : m_maps.maps)
+	{
+		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
+		{
+			if (m_feed.ism2dInput == "dense" && !kf.depth.empty())
+			{
+				if (!obs) obs = depthObservation(kf);
+				ism->insertKeyframeDepth(id, kf.T_world_cam, *obs);
+			}
+			else
+			{
+				std::vector<mrpt::math::TPoint3D> pts;
+				for (sfm::LandmarkId l : kf.landmarks)
+					if (l != sfm::kNoLandmark && map.hasLandmark(l))
+					{
+						const auto& p = map.landmark(l).p_world;
+						pts.emplace_back(p.x(), p.y(), p.z());
+					}
+				if (!ism->floorKnown() && ism->insertionOptions.estimateFloorFromDepth)
+					ism->estimateFloorFromPoints(pts, kf.T_world_cam);
+				ism->insertKeyframePoints(id, kf.T_world_cam, pts);
+			}
+		}
+		else if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get()))
+		{
+			if (!kf.depth.empty()) g3->insertDepthFrame(kf.depth, kf.features.camera, kf.T_world_cam, travelled, id);
+		}
+		else if (!kf.depth.empty())
+		{
+			if (!obs) obs = depthObservation(kf);
+			m->insertObservation(*obs, mrpt::poses::CPose3D(core::sensorPoseFromCameraPose(kf.T_world_cam)));
+		}
+	}
+}
+
+std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses)
+{
+	std::map<std::string, double> out;
+	for (auto& m : m_maps.maps)
+	{
+		const auto t0 = std::chrono::steady_clock::now();
+		std::string name = m->GetRuntimeClass()->className;
+		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
+		{
+			std::map<uint64_t, mrpt::poses::CPose3D> np;
+			for (const auto& [id, T] : newPoses)
+				if (ism->keyframes().count(id)) np[id] = T;
+			ism->applyTrajectoryCorrection(np);
+		}
+		else if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get()))
+		{
+			TrajectoryCorrection corr;
+			for (const auto& [id, T] : newPoses)
+				if (m_insertedPoses.count(id)) corr[id] = PoseCorrection{m_insertedPoses.at(id), T};
+			g3->morphAndMergeSubmaps(corr);
+		}
+		else
+			continue;  // MRPT's own maps cannot be re-anchored: they keep the online poses
+		out[name] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+	}
+	for (const auto& [id, T] : newPoses)
+		if (m_insertedPoses.count(id)) m_insertedPoses[id] = T;
+	return out;
+}
+
+std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const
+{
+	std::vector<std::string> files;
+	std::map<std::string, int> seen;
+	for (const auto& m : m_maps.maps)
+	{
+		const std::string cls = m->GetRuntimeClass()->className;
+		const int n = seen[cls]++;
+		const std::string suffix = n ? "_" + std::to_string(n) : "";
+		if (const auto* ism = dynamic_cast<const CISMOccupancyGrid2D*>(m.get()))
+		{
+			ism->saveAsRosMapServer(dir + "/map_2d" + suffix + ".yaml");
+			ism->saveAsImage(dir + "/map_2d" + suffix + ".png");
+			files.insert(files.end(), {"map_2d" + suffix + ".yaml", "map_2d" + suffix + ".pgm", "map_2d" + suffix + ".png"});
+		}
+		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
+		{
+			g3->saveAsOctomapBinary(dir + "/map_3d" + suffix + ".bt");
+			g3->saveOccupiedAsPly(dir + "/map_3d" + suffix + ".ply");
+			files.insert(files.end(), {"map_3d" + suffix + ".bt", "map_3d" + suffix + ".ply"});
+		}
+		else
+		{
+			// MRPT's own representation (e.g. octoMap writes .bt, pointsMap .txt).
+			std::string base = cls;
+			for (auto& ch : base)
+				if (ch == ':') ch = '_';
+			m->saveMetricMapRepresentationToFile(dir + "/" + base + suffix);
+			files.push_back(base + suffix + ".*");
+		}
+	}
+	return files;
+}
+
+std::string MetricMaps::summaryJson() const
+{
+	std::ostringstream o;
+	o << "[";
+	bool first = true;
+	for (const auto& m : m_maps.maps)
+	{
+		o << (first ? "" : ", ") << "{\"class\": \"" << m->GetRuntimeClass()->className << "\"";
+		if (const auto* ism = dynamic_cast<const CISMOccupancyGrid2D*>(m.get()))
+		{
+			const auto c = ism->countStates();
+			o << ", \"cells\": " << ism->sizeX() * ism->sizeY() << ", \"states\": [" << c[0] << ", " << c[1] << ", " << c[2]
+			  << "], \"keyframes\": " << ism->keyframes().size();
+		}
+		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
+			o << ", \"submaps\": " << g3->numSubmaps() << ", \"memory_bytes\": " << g3->memoryBytes()
+			  << ", \"keyframes\": " << g3->keyframes().size();
+		o << "}";
+		first = false;
+	}
+	o << "]";
+	return o.str();
+}
+
+}  // namespace keygrid::slam

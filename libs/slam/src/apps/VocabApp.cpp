@@ -1,0 +1,214 @@
+#include <keygrid/core/CommandLine.h>
+#include <keygrid/core/FrameSource.h>
+#include <keygrid/core/ProgressBar.h>
+#include <keygrid/loop/Vocabulary.h>
+#include <keygrid/slam/AtomicFile.h>
+#include <keygrid/slam/apps/AppRunner.h>
+#include <keygrid/slam/apps/VocabApp.h>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+namespace keygrid::slam
+{
+namespace
+{
+namespace fs = std::filesystem;
+
+/** Image paths of a folder (sorted) or of a list file (one path per line, '#' comments,
+ * relative paths resolved against the list's folder). */
+std::vector<std::string> imagePaths(const std::string& where)
+{
+	std::vector<std::string> out;
+	if (fs::is_directory(where))
+	{
+		static const std::vector<std::string> exts{".png", ".jpg", ".jpeg", ".bmp", ".ppm", ".pgm", ".tif", ".tiff"};
+		for (const auto& e : fs::directory_iterator(where))
+		{
+			std::string ext = e.path().extension().string();
+			std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+			if (e.is_regular_file() && std::find(exts.begin(), exts.end(), ext) != exts.end()) out.push_back(e.path().string());
+		}
+		std::sort(out.begin(), out.end());
+		if (out.empty()) throw std::runtime_error("no images (png, jpg, bmp, ppm, pgm, tif) in " + where);
+		return out;
+	}
+	std::ifstream f(where);
+	if (!f) throw std::runtime_error("cannot open image folder or list " + where);
+	const fs::path base = fs::path(where).parent_path();
+	std::string line;
+	while (std::getline(f, line))
+	{
+		line.erase(0, line.find_first_not_of(" \t\r"));
+		line.erase(line.find_last_not_of(" \t\r") + 1);
+		if (line.empty() || line[0] == '#') continue;
+		const fs::path p(line);
+		out.push_back(p.is_absolute() ? p.string() : (base / p).string());
+	}
+	if (out.empty()) throw std::runtime_error("image list " + where + " names no images");
+	return out;
+}
+
+class DescriptorExtractor
+{
+   public:
+	DescriptorExtractor(const std::string& kind, int features)
+	{
+		if (kind == "orb") m_f = cv::ORB::create(features);
+		else if (kind == "sift") m_f = cv::SIFT::create(features);
+		else throw core::CommandLineError("--features " + kind + " (must be orb or sift)");
+	}
+	cv::Mat operator()(const cv::Mat& image) const
+	{
+		cv::Mat grey = image;
+		if (image.channels() == 3) cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+		std::vector<cv::KeyPoint> kps;
+		cv::Mat d;
+		m_f->detectAndCompute(grey, cv::noArray(), kps, d);
+		return d;
+	}
+
+   private:
+	cv::Ptr<cv::Feature2D> m_f;
+};
+
+int train(const core::CommandLine& cl)
+{
+	const int inputs = cl.has("images") + cl.has("rawlog") + cl.has("tum");
+	if (inputs != 1) throw core::CommandLineError("train needs exactly one of --images, --rawlog, --tum");
+	if (!cl.has("output")) throw core::CommandLineError("missing --output");
+	loop::VocabularyOptions vo;
+	vo.branching = static_cast<int>(cl.getInt("k"));
+	vo.levels = static_cast<int>(cl.getInt("levels"));
+	vo.seed = static_cast<std::uint64_t>(cl.getInt("seed"));
+	vo.threads = static_cast<int>(cl.getInt("threads"));
+	std::string why;
+	if (!vo.isValid(&why)) throw core::CommandLineError(why);
+	const long maxImages = cl.getInt("max-images");
+	const long every = cl.getInt("every");
+	const long features = cl.getInt("nfeatures");
+	if (maxImages < 0) throw core::CommandLineError("--max-images " + cl.get("max-images") + " (must be >= 0)");
+	if (every < 1) throw core::CommandLineError("--every " + cl.get("every") + " (must be >= 1)");
+	if (features < 1) throw core::CommandLineError("--nfeatures " + cl.get("nfeatures") + " (must be >= 1)");
+	const DescriptorExtractor extract(cl.get("features"), static_cast<int>(features));
+
+	std::vector<cv::Mat> descriptors;
+	std::size_t total = 0;
+	auto keep = [&](std::size_t index) { return index % static_cast<std::size_t>(every) == 0; };
+	auto full = [&] { return maxImages > 0 && descriptors.size() >= static_cast<std::size_t>(maxImages); };
+	auto add = [&](const cv::Mat& d) {
+		descriptors.push_back(d);
+		total += static_cast<std::size_t>(d.rows);
+	};
+	if (cl.has("images"))
+	{
+		const auto paths = imagePaths(cl.get("images"));
+		core::ProgressBar bar("extracting", paths.size());
+		for (std::size_t i = 0; i < paths.size() && !full(); ++i)
+		{
+			if (!keep(i)) continue;
+			const cv::Mat img = cv::imread(paths[i], cv::IMREAD_GRAYSCALE);
+			if (img.empty()) throw std::runtime_error("cannot read image " + paths[i]);
+			add(extract(img));
+			bar.update(i + 1, std::to_string(total) + " descriptors");
+		}
+		bar.finish(std::to_string(total) + " descriptors");
+	}
+	else
+	{
+		const std::string path = cl.has("rawlog") ? cl.get("rawlog") : cl.get("tum");
+		if (cl.has("tum") && !fs::is_directory(path)) throw std::runtime_error("--tum " + path + " is not a folder");
+		if (cl.has("rawlog") && !fs::is_regular_file(path)) throw std::runtime_error("--rawlog " + path + " is not a file");
+		auto src = core::openFrameSource(path);
+		core::ProgressBar bar("extracting", src->sizeHint().value_or(0));
+		core::Frame f;
+		std::size_t index = 0;
+		while (!full() && src->next(f))
+		{
+			if (keep(index++) && !f.grey.empty()) add(extract(f.grey));
+			bar.update(index, std::to_string(total) + " descriptors");
+		}
+		bar.finish(std::to_string(total) + " descriptors");
+	}
+	if (total == 0) throw std::runtime_error("no descriptors extracted (no images or no texture)");
+
+	core::ProgressBar bar("clustering", total);
+	const loop::Vocabulary v = loop::Vocabulary::train(descriptors, vo, [&](std::size_t done, std::size_t) { bar.update(done); });
+	bar.finish();
+	std::ostringstream os;
+	v.save(os);
+	writeFileAtomically(cl.get("output"), os.str());
+	std::cout << v.describe() << "\n"
+			  << "trained on " << total << " descriptors in " << std::fixed << std::setprecision(1) << bar.elapsed()
+			  << " s -> " << cl.get("output") << " (" << os.str().size() / 1024 << " KiB)\n";
+	return 0;
+}
+
+int info(const std::string& path)
+{
+	const loop::Vocabulary v = loop::Vocabulary::load(path);
+	std::size_t zeroIdf = 0;
+	double sumIdf = 0, maxIdf = 0;
+	for (std::size_t w = 0; w < v.numWords(); ++w)
+	{
+		const double idf = v.idf(static_cast<loop::WordId>(w));
+		sumIdf += idf;
+		maxIdf = std::max(maxIdf, idf);
+		zeroIdf += idf <= 0;
+	}
+	std::cout << path << ": " << v.describe() << "\n"
+			  << "idf: mean " << sumIdf / static_cast<double>(v.numWords()) << ", max " << maxIdf << ", " << zeroIdf
+			  << " words in every training image (ignored)\n";
+	return 0;
+}
+}  // namespace
+
+int VocabApp::run(int argc, const char* const* argv)
+{
+	return runApp("keygrid-vocab", [&] {
+		core::CommandLine cl(
+			"keygrid-vocab",
+			"Vocabulary trees for loop closure (Nister & Stewenius hierarchical k-means, TF-IDF).\n"
+			"  keygrid-vocab train (--images DIR|LIST | --rawlog X.rawlog | --tum TUM_DIR) --output vocab.bin\n"
+			"  keygrid-vocab info vocab.bin\n"
+			"Training needs nothing downloaded: use the sequence to be mapped itself (a pre-pass) or\n"
+			"any images of similar scenes.");
+		cl.positionals("train | info VOCAB", "sub-command (and the vocabulary file for info)")
+			.option("images", "DIR|LIST", "train on a folder of images or a text file listing image paths")
+			.option("rawlog", "X.rawlog", "train on the grey images of an MRPT rawlog")
+			.option("tum", "TUM_DIR", "train on the rgb images of a TUM RGB-D folder")
+			.option("output", "vocab.bin", "vocabulary file to write (train)")
+			.option("k", "K", "branching factor", false, "10")
+			.option("levels", "L", "tree depth (at most K^L words)", false, "4")
+			.option("features", "orb|sift", "descriptor: ORB (binary, Hamming) or SIFT (float, L2)", false, "orb")
+			.option("nfeatures", "N", "features per image", false, "1000")
+			.option("max-images", "N", "use at most N images (0: all)", false, "0")
+			.option("every", "N", "use every N-th image/frame", false, "1")
+			.option("seed", "S", "k-means++ seed (same seed, same vocabulary)", false, "1")
+			.option("threads", "T", "training threads (0: all cores)", false, "0");
+		if (!cl.parse(argc, argv)) return 0;
+		const auto& pos = cl.positional();
+		if (pos.empty()) throw core::CommandLineError("missing sub-command (train or info)");
+		if (pos[0] == "train")
+		{
+			if (pos.size() != 1) throw core::CommandLineError("unexpected argument '" + pos[1] + "'");
+			return train(cl);
+		}
+		if (pos[0] == "info")
+		{
+			if (pos.size() != 2) throw core::CommandLineError("info needs exactly one vocabulary file");
+			return info(pos[1]);
+		}
+		throw core::CommandLineError("unknown sub-command '" + pos[0] + "' (train or info)");
+	});
+}
+
+}  // namespace keygrid::slam
