@@ -1,0 +1,175 @@
+#include <keygrid/loop/RigidRansac.h>
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+namespace keygrid::loop
+{
+bool RigidRansacOptions::isValid(std::string* why) const
+{
+	auto fail = [&](const std::string& s) {
+		if (why) *why = s;
+		return false;
+	};
+	if (!(inlierThreshold > 0)) return fail("inlier_threshold = " + std::to_string(inlierThreshold) + " (must be > 0)");
+	if (minInliers < 3) return fail("min_inliers = " + std::to_string(minInliers) + " (must be >= 3)");
+	if (maxIterations < 1) return fail("max_iterations = " + std::to_string(maxIterations) + " (must be >= 1)");
+	if (!(confidence > 0 && confidence < 1)) return fail("confidence = " + std::to_string(confidence) + " (must be in (0, 1))");
+	if (refinementRounds < 0) return fail("refinement_rounds = " + std::to_string(refinementRounds) + " (must be >= 0)");
+	return true;
+}
+
+void RigidRansacOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	inlierThreshold = c.read_double(s, "inlier_threshold", inlierThreshold);
+	minInliers = c.read_int(s, "min_inliers", minInliers);
+	maxIterations = c.read_int(s, "max_iterations", maxIterations);
+	confidence = c.read_double(s, "confidence", confidence);
+	refinementRounds = c.read_int(s, "refinement_rounds", refinementRounds);
+	estimateScale = c.read_bool(s, "estimate_scale", estimateScale);
+	seed = c.read_uint64_t(s, "seed", seed);
+	std::string why;
+	if (!isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
+}
+
+void RigidRansacOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	c.write(s, "inlier_threshold", inlierThreshold, 34, 40, "3D distance for inliers [m]");
+	c.write(s, "min_inliers", minInliers, 34, 40, "inliers needed to accept");
+	c.write(s, "max_iterations", maxIterations, 34, 40, "RANSAC hypotheses at most");
+	c.write(s, "confidence", confidence, 34, 40, "early stop probability");
+	c.write(s, "refinement_rounds", refinementRounds, 34, 40, "re-fits on inliers");
+	c.write(s, "estimate_scale", estimateScale, 34, 40, "Sim(3) instead of SE(3)");
+	c.write(s, "seed", seed, 34, 40, "sampler seed");
+}
+
+namespace
+{
+/** Umeyama fit of dst ~= s R src + t on the listed pairs; returns false when degenerate. */
+bool fit(
+	const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, const std::vector<int>& idx,
+	bool withScale, Eigen::Matrix4d& T)
+{
+	Eigen::Matrix3Xd src(3, idx.size()), dst(3, idx.size());
+	for (std::size_t i = 0; i < idx.size(); ++i)
+	{
+		src.col(static_cast<Eigen::Index>(i)) = b[static_cast<std::size_t>(idx[i])];
+		dst.col(static_cast<Eigen::Index>(i)) = a[static_cast<std::size_t>(idx[i])];
+	}
+	T = Eigen::umeyama(src, dst, withScale);
+	return T.allFinite();
+}
+
+/** Classifies pairs; returns the inlier count and the sum of squared inlier residuals. */
+int classify(
+	const std::vector<Eigen::Vector3d>& a, const std::vector<Eigen::Vector3d>& b, const Eigen::Matrix4d& T,
+	double thr2, std::vector<char>& inlier, double& sse)
+{
+	const Eigen::Matrix3d sR = T.topLeftCorner<3, 3>();
+	const Eigen::Vector3d t = T.topRightCorner<3, 1>();
+	int n = 0;
+	sse = 0;
+	for (std::size_t i = 0; i < a.size(); ++i)
+	{
+		const double e2 = (a[i] - (sR * b[i] + t)).squaredNorm();
+		inlier[i] = e2 < thr2;
+		if (inlier[i])
+		{
+			++n;
+			sse += e2;
+		}
+	}
+	return n;
+}
+}  // namespace
+
+RigidRansacResult estimateRigidTransformRansac(
+	const std::vector<Eigen::Vector3d>& p_a, const std::vector<Eigen::Vector3d>& p_b, const RigidRansacOptions& opts)
+{
+	if (p_a.size() != p_b.size())
+		throw std::invalid_argument(
+			"estimateRigidTransformRansac: " + std::to_string(p_a.size()) + " vs " + std::to_string(p_b.size()) + " points");
+	std::string why;
+	if (!opts.isValid(&why)) throw std::invalid_argument("RigidRansacOptions: " + why);
+	RigidRansacResult res;
+	const std::size_t n = p_a.size();
+	res.inlier.assign(n, 0);
+	if (n < 3) return res;
+
+	const double thr2 = opts.inlierThreshold * opts.inlierThreshold;
+	std::mt19937_64 rng(opts.seed);
+	std::uniform_int_distribution<std::size_t> pick(0, n - 1);
+	std::vector<char> inl(n);
+	Eigen::Matrix4d best = Eigen::Matrix4d::Identity();
+	int bestCount = -1;
+	double bestSse = 0;
+	int needed = opts.maxIterations;
+	for (int it = 0; it < std::min(needed, opts.maxIterations); ++it)
+	{
+		++res.iterations;
+		std::size_t s[3];
+		s[0] = pick(rng);
+		do s[1] = pick(rng);
+		while (s[1] == s[0]);
+		do s[2] = pick(rng);
+		while (s[2] == s[0] || s[2] == s[1]);
+		// Degenerate samples (collinear or coincident points) do not fix a rotation.
+		const double areaB = (p_b[s[1]] - p_b[s[0]]).cross(p_b[s[2]] - p_b[s[0]]).norm();
+		const double areaA = (p_a[s[1]] - p_a[s[0]]).cross(p_a[s[2]] - p_a[s[0]]).norm();
+		if (areaA < 1e-3 * thr2 || areaB < 1e-3 * thr2) continue;
+		Eigen::Matrix4d T;
+		if (!fit(p_a, p_b, {static_cast<int>(s[0]), static_cast<int>(s[1]), static_cast<int>(s[2])}, opts.estimateScale, T))
+			continue;
+		double sse;
+		const int count = classify(p_a, p_b, T, thr2, inl, sse);
+		if (count > bestCount || (count == bestCount && sse < bestSse))
+		{
+			bestCount = count;
+			bestSse = sse;
+			best = T;
+			// Hypotheses needed so that P(no all-inlier sample) < 1 - confidence.
+			const double w = static_cast<double>(count) / static_cast<double>(n);
+			const double pGood = w * w * w;
+			if (pGood >= 1.0) needed = it + 1;
+			else if (pGood > 0)
+				needed = static_cast<int>(std::ceil(std::log(1 - opts.confidence) / std::log(1 - pGood)));
+		}
+	}
+	if (bestCount < 3) return res;
+
+	// Refinement: least-squares fit on all inliers, re-classify, until the set stops changing.
+	double sse = 0;
+	int count = classify(p_a, p_b, best, thr2, inl, sse);
+	for (int r = 0; r < opts.refinementRounds && count >= 3; ++r)
+	{
+		std::vector<int> idx;
+		for (std::size_t i = 0; i < n; ++i)
+			if (inl[i]) idx.push_back(static_cast<int>(i));
+		Eigen::Matrix4d T;
+		if (!fit(p_a, p_b, idx, opts.estimateScale, T)) break;
+		std::vector<char> inl2(n);
+		double sse2;
+		const int count2 = classify(p_a, p_b, T, thr2, inl2, sse2);
+		if (count2 < count) break;  // keep the larger consensus
+		const bool same = inl2 == inl;
+		best = T;
+		inl = std::move(inl2);
+		count = count2;
+		sse = sse2;
+		if (same) break;
+	}
+	res.numInliers = count;
+	res.inlier = inl;
+	res.rmse = count > 0 ? std::sqrt(sse / count) : 0.0;
+	res.scale = opts.estimateScale ? best.topLeftCorner<3, 3>().col(0).norm() : 1.0;
+	res.T_a_b.linear() = best.topLeftCorner<3, 3>() / res.scale;
+	res.T_a_b.translation() = best.topRightCorner<3, 1>();
+	res.success = count >= opts.minInliers;
+	return res;
+}
+
+}  // namespace keygrid::loop
