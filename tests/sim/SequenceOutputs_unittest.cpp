@@ -82,6 +82,18 @@ TEST(SequenceOutputs, SameSeedGivesByteIdenticalFiles)
 	EXPECT_EQ(slurp(a + "/groundtruth.txt"), slurp(c + "/groundtruth.txt"));
 }
 
+TEST(SequenceOutputs, ToolNeverWritesIntoTheSceneFile)
+{
+	// Regression: overriding the seed once rewrote the user's scene INI.
+	const std::string scene = writeScene("sim_tool_ro", tinyRoomIni(2));
+	const std::string before = slurp(scene);
+	std::string log;
+	ASSERT_EQ(test::runCommand(test::toolPath("keygrid-sim") + " --quiet --seed 99 --frames 2 --scene " + scene +
+								   " --output " + test::scratchDir("sim_tool_ro_out"), &log), 0)
+		<< log;
+	EXPECT_EQ(slurp(scene), before);
+}
+
 TEST(SequenceOutputs, ToolOutputsAreReadable)
 {
 	const std::string scene = writeScene("sim_tool_in", tinyRoomIni(9));

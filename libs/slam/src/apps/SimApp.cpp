@@ -5,7 +5,8 @@
 #include <keygrid/sim/SequenceWriter.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/SimApp.h>
-#include <mrpt/config/CConfigFile.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/vector_loadsave.h>
 #include <mrpt/system/filesystem.h>
 
 #include <cstdio>
@@ -61,9 +62,10 @@ int SimApp::run(int argc, const char* const* argv)
 		const std::string scenePath = cl.get("scene");
 		if (!mrpt::system::fileExists(scenePath))
 			throw std::runtime_error("scene file '" + scenePath + "' does not exist");
-		// The INI is only read: changes made here (--seed) are never saved back.
-		mrpt::config::CConfigFile cfg(scenePath);
-		cfg.discardSavingChanges();
+		// The INI is only read: overrides (--seed) go to an in-memory copy. (An
+		// mrpt::config::CConfigFile would write them back into the user's scene file on
+		// destruction; discardSavingChanges() is undone by any later write().)
+		mrpt::config::CConfigFileMemory cfg(mrpt::io::file_get_contents(scenePath));
 		if (cl.has("seed"))
 		{
 			const long seed = cl.getInt("seed");
