@@ -173,6 +173,13 @@ void LocalMapper::fuseInto(
 	}
 }
 
+int LocalMapper::fuseLandmarks(KeyFrameId target, const std::vector<LandmarkId>& lms, const PinholeIntrinsics& K)
+{
+	LocalMappingReport rep;
+	fuseInto(target, lms, K, rep);
+	return rep.fusedLandmarks + rep.addedObservations;
+}
+
 void LocalMapper::fuse(KeyFrameId kfId, const PinholeIntrinsics& K, LocalMappingReport& rep)
 {
 	const auto neighbours = m_map.bestCovisibles(kfId, static_cast<std::size_t>(m_opts.fuseNeighbours));

@@ -158,6 +158,12 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 	return out;
 }
 
+void MetricMaps::notifyLoopClosure()
+{
+	for (auto& m : m_maps.maps)
+		if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get())) g3->notifyLoopClosure();
+}
+
 std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const
 {
 	std::vector<std::string> files;

@@ -18,6 +18,7 @@ System::System(const SlamConfig& cfg)
 	  m_tracker(m_map, cfg.tracker),
 	  m_mapper(m_map, cfg.mapping, cfg.tracker.matcher)
 {
+	if (cfg.loop.enabled) m_loopCloser = std::make_unique<LoopCloser>(m_map, m_mapper, cfg.loop, cfg.tracker.matcher);
 }
 
 sfm::FrameFeatures System::extract(const core::Frame& frame) const { return m_extractor.extract(frame); }
@@ -52,6 +53,25 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 			t0 = std::chrono::steady_clock::now();
 			m_maps->insertKeyFrame(m_map, tf.keyframe, m_travelled);
 			m_timings.add("map_insertion", secondsSince(t0));
+		}
+		if (m_loopCloser && m_map.hasKeyFrame(tf.keyframe))
+		{
+			t0 = std::chrono::steady_clock::now();
+			auto ev = m_loopCloser->process(tf.keyframe, tf.index, K);
+			m_timings.add("loop_closing", secondsSince(t0));
+			if (ev)
+			{
+				// The frame that created the keyframe is the tracker's last frame.
+				m_tracker.onMapCorrected(m_map.keyframe(tf.keyframe).T_world_cam);
+				tf.T_world_cam = m_map.keyframe(tf.keyframe).T_world_cam;
+				m_lastTrackedPose = tf.T_world_cam;
+				if (m_maps)
+				{
+					for (const auto& [name, sec] : m_maps->applyCorrection(ev->newPoses)) m_timings.add("map_correction:" + name, sec);
+					m_maps->notifyLoopClosure();
+				}
+				m_loops.push_back(std::move(*ev));
+			}
 		}
 		m_stats.keyframesCreated++;
 		m_stats.keyframesCulled += rep.culledKeyFrames;

@@ -179,6 +179,17 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	}
 	writeFileAtomically(o.output + "/keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
 
+	if (sys.loopCloser() && sys.loopCloser()->lastPoseGraph())
+	{
+		try
+		{
+			sys.loopCloser()->lastPoseGraph()->writeG2o(o.output + "/posegraph.g2o");
+		}
+		catch (const std::exception& e)
+		{
+			if (res.error.empty()) res.error = std::string("writing posegraph.g2o: ") + e.what();
+		}
+	}
 	std::vector<std::string> mapFiles;
 	if (sys.metricMaps())
 	{
@@ -226,7 +237,16 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "  \"landmarks\": " << sys.map().numLandmarks() << ",\n";
 	js << "  \"landmarks_culled\": " << st.landmarksCulled << ",\n";
 	js << "  \"landmarks_fused\": " << st.landmarksFused << ",\n";
-	js << "  \"loop_closures\": [],\n";
+	js << "  \"loop_closures\": [";
+	for (std::size_t i = 0; i < sys.loopClosures().size(); i++)
+	{
+		const auto& ev = sys.loopClosures()[i];
+		char l[256];
+		std::snprintf(l, sizeof(l), "%s{\"frame\": %zu, \"keyframe\": %llu, \"loop_keyframe\": %llu, \"score\": %.4f, \"inliers\": %d, \"correction_m\": %.4f, \"seconds\": %.4f}",
+					  i ? ", " : "", ev.frameIndex, static_cast<unsigned long long>(ev.keyframe), static_cast<unsigned long long>(ev.loopKeyFrame), ev.score, ev.inliers, ev.correctionMetres, ev.seconds);
+		js << l;
+	}
+	js << "],\n";
 	js << "  \"maps\": " << (sys.metricMaps() ? sys.metricMaps()->summaryJson() : std::string("[]")) << ",\n";
 	{
 		char m[256];

@@ -59,6 +59,11 @@ class LocalMapper
 	 * map.mutex(). */
 	LocalMappingReport process(KeyFrameId kf, const PinholeIntrinsics& K);
 
+	/** Projects landmarks `lms` into keyframe `target`, merging duplicates and adding missing
+	 * observations (used after a loop closure to join both sides of the loop). Returns the
+	 * number of landmarks fused. */
+	int fuseLandmarks(KeyFrameId target, const std::vector<LandmarkId>& lms, const PinholeIntrinsics& K);
+
    private:
 	int cullRecentLandmarks(KeyFrameId current);
 	/** New landmarks from keypoints without one, matched with neighbour keyframes. */

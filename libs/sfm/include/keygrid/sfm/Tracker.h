@@ -54,6 +54,9 @@ class Tracker
 	TrackedFrame track(const core::Frame& frame, FrameFeatures features);
 
 	TrackingState state() const { return m_state; }
+	/** After a map correction (loop closure) moved the last tracked frame: its new pose. The
+	 * motion model (relative) stays valid. */
+	void onMapCorrected(const mrpt::poses::CPose3D& T_world_lastFrame) { m_lastPose = T_world_lastFrame; }
 	const TrackerOptions& options() const { return m_opts; }
 	/** Landmarks matched as inliers in the last frame (for diagnostics and the maps). */
 	const std::vector<LandmarkId>& lastInlierLandmarks() const { return m_lastInliers; }

@@ -53,6 +53,9 @@ class MetricMaps
 	 * Returns seconds spent per map name. */
 	std::map<std::string, double> applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses);
 
+	/** Tells the maps the camera is back in mapped space (3D grid: localization mode). */
+	void notifyLoopClosure();
+
 	/** Writes each map's outputs into dir (map_2d.{pgm,yaml,png}, map_3d.bt, map_3d.ply, ...);
 	 * returns the file names written. */
 	std::vector<std::string> writeOutputs(const std::string& dir) const;

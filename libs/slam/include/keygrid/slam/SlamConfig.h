@@ -4,12 +4,13 @@
  *
  * Sections: [slam] (mode, camera), [features], [tracker], [mapping] (local mapping and local
  * bundle adjustment), [refinement] (final global bundle adjustment and frame re-estimation),
- * [maps] (how keyframes feed the maps) and [MappingApplication] (the maps themselves, MRPT's
+ * [loop_closing] (place recognition and pose graph), [maps] (how keyframes feed the maps) and [MappingApplication] (the maps themselves, MRPT's
  * CMultiMetricMap format, see MetricMaps). Keys absent from the file keep their documented defaults.
  */
 #include <keygrid/sfm/FeatureExtractor.h>
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/TrackerOptions.h>
+#include <keygrid/slam/LoopCloser.h>
 #include <keygrid/slam/MetricMaps.h>
 
 #include <string>
@@ -39,6 +40,7 @@ struct SlamConfig
 	sfm::LocalMapperOptions mapping;
 	RefinementOptions refinement;
 	MapFeedOptions maps;
+	LoopClosingOptions loop;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;

@@ -9,6 +9,7 @@
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/LoopCloser.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <keygrid/slam/StageTimings.h>
@@ -55,6 +56,8 @@ class System
 	const sfm::SparseMap& map() const { return m_map; }
 	const std::vector<sfm::TrackedFrame>& frames() const { return m_frames; }
 	const SystemStats& stats() const { return m_stats; }
+	const std::vector<LoopClosureEvent>& loopClosures() const { return m_loops; }
+	const LoopCloser* loopCloser() const { return m_loopCloser.get(); }
 	StageTimings& timings() { return m_timings; }
 	const StageTimings& timings() const { return m_timings; }
 	const SlamConfig& config() const { return m_cfg; }
@@ -70,6 +73,8 @@ class System
 	std::optional<sfm::PinholeIntrinsics> m_K;
 	bool m_finished{false};
 	std::unique_ptr<MetricMaps> m_maps;
+	std::unique_ptr<LoopCloser> m_loopCloser;
+	std::vector<LoopClosureEvent> m_loops;
 	double m_travelled{0};
 	std::optional<mrpt::poses::CPose3D> m_lastTrackedPose;
 	SystemStats m_stats;

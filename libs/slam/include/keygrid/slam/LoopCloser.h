@@ -1,0 +1,109 @@
+#pragma once
+/** \file LoopCloser.h
+ * Place recognition and loop correction for the SLAM system: each new keyframe is described
+ * with the vocabulary tree, candidates come from the inverted index (scores normalised by the
+ * keyframe's covisible neighbours), must be consistent over consecutive keyframes, and are
+ * verified geometrically with depth (3D-3D RANSAC). A verified loop adds an edge to the SE(3)
+ * keyframe pose graph; after optimisation landmarks follow their keyframes and the duplicated
+ * landmarks around the loop are fused.
+ */
+#include <keygrid/loop/ConsistencyChecker.h>
+#include <keygrid/loop/KeyFrameDatabase.h>
+#include <keygrid/loop/PoseGraph.h>
+#include <keygrid/loop/RigidRansac.h>
+#include <keygrid/loop/Vocabulary.h>
+#include <keygrid/sfm/LocalMapper.h>
+#include <keygrid/sfm/SparseMap.h>
+
+#include <map>
+#include <optional>
+#include <set>
+#include <string>
+
+namespace keygrid::slam
+{
+struct LoopClosingOptions
+{
+	/** Detect and correct loops (Default: true) */
+	bool enabled{true};
+	/** Vocabulary file (keygrid-vocab train); empty: trained on the first keyframes (Default: empty) */
+	std::string vocabulary;
+	/** Keyframes whose descriptors train the vocabulary when no file is given (Default: 10) */
+	int trainKeyFrames{10};
+	/** Tree shape used for that training (Default: branching 10, 3 levels = 1000 words) */
+	loop::VocabularyOptions vocabularyOptions{10, 3, 10, 1, 1};
+	/** Candidates must be at least this many keyframes older than the query (Default: 15) */
+	int minKeyFrameGap{15};
+	/** Consecutive keyframes that must agree on a candidate group (Default: 3) */
+	int consistency{3};
+	/** Geometric verification: RANSAC on matched keypoints with depth */
+	loop::RigidRansacOptions ransac{0.04, 40, 300, 0.999, 5, false, 42};
+	/** Plausibility: the loop may move the current keyframe (relative to the loop keyframe) by
+	 * at most max_correction_base + max_correction_ratio x the path travelled between them
+	 * [m], and rotate it by at most max_correction_deg. Drift is a small fraction of the path;
+	 * larger "corrections" come from look-alike places (Default: 0.1 m, 0.1, 10 deg) */
+	double maxCorrectionBase{0.1}, maxCorrectionRatio{0.1}, maxCorrectionDeg{10.0};
+	/** Covisibility edges of the pose graph need this many shared landmarks (Default: 100) */
+	int covisibilityEdgeMinWeight{100};
+	loop::PoseGraphOptions poseGraph;
+
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+};
+
+/** One closed loop, with the pose change of every keyframe (for the maps). */
+struct LoopClosureEvent
+{
+	std::size_t frameIndex{0};
+	sfm::KeyFrameId keyframe{0}, loopKeyFrame{0};
+	double score{0};
+	int inliers{0};
+	double correctionMetres{0};  //!< how far the current keyframe moved
+	double seconds{0};
+	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> newPoses;
+};
+
+class LoopCloser
+{
+   public:
+	LoopCloser(sfm::SparseMap& map, sfm::LocalMapper& mapper, const LoopClosingOptions& opts,
+			   const sfm::MatcherOptions& matcher);
+
+	/** Handles keyframe `kf` (after its local mapping). Returns the event if a loop was closed. */
+	std::optional<LoopClosureEvent> process(sfm::KeyFrameId kf, std::size_t frameIndex, const sfm::PinholeIntrinsics& K);
+
+	bool hasVocabulary() const { return !m_vocab.empty(); }
+	const loop::Vocabulary& vocabulary() const { return m_vocab; }
+	/** The keyframe pose graph of the last correction (for posegraph.g2o). */
+	const std::optional<loop::PoseGraph>& lastPoseGraph() const { return m_lastGraph; }
+
+   private:
+	void trainIfReady();
+	std::optional<sfm::KeyFrameId> detect(sfm::KeyFrameId kf, const loop::BowVector& bow, double& score);
+	/** False when the loop measurement disagrees with the estimate more than drift can explain. */
+	bool plausible(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur) const;
+	bool verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, int& inliers);
+	LoopClosureEvent correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K);
+
+	sfm::SparseMap& m_map;
+	sfm::LocalMapper& m_mapper;
+	LoopClosingOptions m_opts;
+	sfm::MatcherOptions m_matcher;
+	loop::Vocabulary m_vocab;
+	loop::KeyFrameDatabase m_db;
+	std::set<sfm::KeyFrameId> m_dbIds;
+	loop::ConsistencyChecker m_consistency;
+	std::optional<loop::PoseGraph> m_lastGraph;
+	sfm::KeyFrameId m_lastLoopKf{0};
+	bool m_anyLoop{false};
+
+   public:
+	/** Loops that passed verification but were rejected as implausible (diagnostics). */
+	int rejectedImplausible{0};
+};
+
+/** CPose3D <-> Eigen isometry. */
+Eigen::Isometry3d toIsometry(const mrpt::poses::CPose3D& p);
+mrpt::poses::CPose3D toCPose3D(const Eigen::Isometry3d& T);
+
+}  // namespace keygrid::slam

@@ -1,0 +1,291 @@
+#include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/LoopCloser.h>
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/math/CMatrixFixed.h>
+
+#include <chrono>
+#include <set>
+
+namespace keygrid::slam
+{
+Eigen::Isometry3d toIsometry(const mrpt::poses::CPose3D& p)
+{
+	Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+	const auto R = p.getRotationMatrix();
+	for (int i = 0; i < 3; i++)
+	{
+		for (int j = 0; j < 3; j++) T.linear()(i, j) = R(i, j);
+		T.translation()(i) = p.m_coords[i];
+	}
+	return T;
+}
+
+mrpt::poses::CPose3D toCPose3D(const Eigen::Isometry3d& T)
+{
+	mrpt::math::CMatrixDouble33 R;
+	mrpt::math::CVectorFixedDouble<3> t;
+	// Re-orthonormalise: the optimiser works on quaternions, round-off accumulates.
+	const Eigen::Matrix3d Rn = Eigen::Quaterniond(T.linear()).normalized().toRotationMatrix();
+	for (int i = 0; i < 3; i++)
+	{
+		for (int j = 0; j < 3; j++) R(i, j) = Rn(i, j);
+		t[i] = T.translation()(i);
+	}
+	return mrpt::poses::CPose3D::FromRotationAndTranslation(R, t);
+}
+
+void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	enabled = c.read_bool(s, "enabled", enabled);
+	vocabulary = c.read_string(s, "vocabulary", vocabulary);
+	trainKeyFrames = c.read_int(s, "train_keyframes", trainKeyFrames);
+	minKeyFrameGap = c.read_int(s, "min_keyframe_gap", minKeyFrameGap);
+	consistency = c.read_int(s, "consistency", consistency);
+	ransac.minInliers = c.read_int(s, "min_inliers", ransac.minInliers);
+	ransac.inlierThreshold = c.read_double(s, "inlier_threshold", ransac.inlierThreshold);
+	covisibilityEdgeMinWeight = c.read_int(s, "covisibility_edge_min_weight", covisibilityEdgeMinWeight);
+	maxCorrectionBase = c.read_double(s, "max_correction_base", maxCorrectionBase);
+	maxCorrectionRatio = c.read_double(s, "max_correction_ratio", maxCorrectionRatio);
+	maxCorrectionDeg = c.read_double(s, "max_correction_deg", maxCorrectionDeg);
+	if (!(maxCorrectionBase >= 0 && maxCorrectionRatio >= 0 && maxCorrectionDeg > 0))
+		throw std::invalid_argument("[" + s + "] max_correction_base/_ratio must be >= 0 and max_correction_deg > 0");
+	vocabularyOptions.branching = c.read_int(s, "vocabulary_branching", vocabularyOptions.branching);
+	vocabularyOptions.levels = c.read_int(s, "vocabulary_levels", vocabularyOptions.levels);
+	if (trainKeyFrames < 2) throw std::invalid_argument("[" + s + "] train_keyframes = " + std::to_string(trainKeyFrames) + " (must be >= 2)");
+	if (consistency < 1) throw std::invalid_argument("[" + s + "] consistency = " + std::to_string(consistency) + " (must be >= 1)");
+	if (minKeyFrameGap < 1) throw std::invalid_argument("[" + s + "] min_keyframe_gap must be >= 1");
+	std::string why;
+	if (!ransac.isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
+	if (!vocabularyOptions.isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
+}
+
+void LoopClosingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	c.write(s, "enabled", enabled, 30, 40, "detect and correct loops");
+	c.write(s, "vocabulary", vocabulary.empty() ? std::string("train") : vocabulary, 30, 40, "vocabulary file, or train (from the first keyframes)");
+	c.write(s, "train_keyframes", trainKeyFrames, 30, 40, "keyframes that train the vocabulary");
+	c.write(s, "vocabulary_branching", vocabularyOptions.branching, 30, 40, "");
+	c.write(s, "vocabulary_levels", vocabularyOptions.levels, 30, 40, "");
+	c.write(s, "min_keyframe_gap", minKeyFrameGap, 30, 40, "candidates at least this many keyframes older");
+	c.write(s, "consistency", consistency, 30, 40, "consecutive keyframes agreeing on a candidate");
+	c.write(s, "min_inliers", ransac.minInliers, 30, 40, "3D-3D RANSAC inliers to accept a loop");
+	c.write(s, "inlier_threshold", ransac.inlierThreshold, 30, 40, "[m]");
+	c.write(s, "covisibility_edge_min_weight", covisibilityEdgeMinWeight, 30, 40, "pose-graph covisibility edges");
+	c.write(s, "max_correction_base", maxCorrectionBase, 30, 40, "[m] largest loop correction: base +");
+	c.write(s, "max_correction_ratio", maxCorrectionRatio, 30, 40, "... ratio x path between the keyframes");
+	c.write(s, "max_correction_deg", maxCorrectionDeg, 30, 40, "[deg] largest loop rotation correction");
+}
+
+LoopCloser::LoopCloser(sfm::SparseMap& map, sfm::LocalMapper& mapper, const LoopClosingOptions& opts, const sfm::MatcherOptions& matcher)
+	: m_map(map), m_mapper(mapper), m_opts(opts), m_matcher(matcher), m_consistency(opts.consistency)
+{
+	if (!opts.vocabulary.empty() && opts.vocabulary != "train") m_vocab = loop::Vocabulary::load(opts.vocabulary);
+}
+
+void LoopCloser::trainIfReady()
+{
+	if (!m_vocab.empty() || static_cast<int>(m_map.numKeyFrames()) < m_opts.trainKeyFrames) return;
+	std::vector<cv::Mat> descs;
+	for (const auto& [id, kf] : m_map.keyframes()) descs.push_back(kf.features.descriptors);
+	m_vocab = loop::Vocabulary::train(descs, m_opts.vocabularyOptions);
+	for (const auto& [id, kf] : m_map.keyframes())
+	{
+		m_db.add(id, m_vocab.transform(kf.features.descriptors));
+		m_dbIds.insert(id);
+	}
+}
+
+std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const loop::BowVector& bow, double& score)
+{
+	// Reference: the lowest similarity with the covisible keyframes (ORB-SLAM's normalisation).
+	const auto covis = m_map.bestCovisibles(kfId, 1000);
+	double ref = 1.0;
+	for (auto c : covis)
+		if (m_db.contains(c)) ref = std::min(ref, m_vocab.score(bow, m_db.bow(c)));
+	if (covis.empty()) ref = 0.0;
+	loop::DatabaseQuery q;
+	q.maxResults = 10;
+	q.referenceScore = ref;
+	q.minRatioToReference = 1.0;
+	q.exclude.insert(kfId);
+	for (auto c : covis) q.exclude.insert(c);
+	for (const auto& [id, kf] : m_map.keyframes())
+		if (id + static_cast<sfm::KeyFrameId>(m_opts.minKeyFrameGap) > kfId) q.exclude.insert(id);
+	const auto cands = m_db.query(bow, q);
+	std::vector<loop::CandidateGroup> groups;
+	for (const auto& c : cands)
+	{
+		if (!m_map.hasKeyFrame(c.id)) continue;
+		loop::CandidateGroup g;
+		g.candidate = c.id;
+		g.group.insert(c.id);
+		for (auto n : m_map.bestCovisibles(c.id, 10)) g.group.insert(n);
+		groups.push_back(g);
+	}
+	const auto consistent = m_consistency.check(groups);
+	for (const auto& c : cands)
+		if (std::find(consistent.begin(), consistent.end(), c.id) != consistent.end())
+		{
+			score = c.score;
+			return c.id;
+		}
+	return std::nullopt;
+}
+
+bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, int& inliers)
+{
+	const auto& a = m_map.keyframe(cand);
+	const auto& b = m_map.keyframe(cur);
+	std::vector<Eigen::Vector3d> pa, pb;
+	for (const auto& [i, j] : sfm::matchBruteForce(a.features, b.features, m_matcher, 0.8f))
+	{
+		const float da = a.features.depth[i], db = b.features.depth[j];
+		if (da <= 0 || db <= 0) continue;
+		pa.push_back(sfm::backProject(K, a.features.undistorted[i].x, a.features.undistorted[i].y, da));
+		pb.push_back(sfm::backProject(K, b.features.undistorted[j].x, b.features.undistorted[j].y, db));
+	}
+	if (static_cast<int>(pa.size()) < m_opts.ransac.minInliers) return false;
+	const auto r = loop::estimateRigidTransformRansac(pa, pb, m_opts.ransac);
+	inliers = r.numInliers;
+	if (!r.success) return false;
+	T_cand_cur = r.T_a_b;
+	return true;
+}
+
+bool LoopCloser::plausible(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur) const
+{
+	// Path travelled between the two keyframes, along the keyframe sequence.
+	double path = 0;
+	std::optional<Eigen::Vector3d> last;
+	for (auto it = m_map.keyframes().lower_bound(cand); it != m_map.keyframes().end() && it->first <= cur; ++it)
+	{
+		const Eigen::Vector3d c = it->second.cameraCenter();
+		if (last) path += (c - *last).norm();
+		last = c;
+	}
+	const Eigen::Isometry3d est = toIsometry(m_map.keyframe(cand).T_world_cam).inverse() * toIsometry(m_map.keyframe(cur).T_world_cam);
+	const Eigen::Isometry3d E = est.inverse() * T_cand_cur;
+	const double dt = E.translation().norm();
+	const double dr = Eigen::AngleAxisd(E.linear()).angle() * 180.0 / M_PI;
+	return dt <= m_opts.maxCorrectionBase + m_opts.maxCorrectionRatio * path && dr <= m_opts.maxCorrectionDeg;
+}
+
+LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K)
+{
+	// Pose graph: every keyframe; consecutive keyframes and strong covisibility pairs keep
+	// their current relative poses (weight 1), the loop edge brings the measured one.
+	loop::PoseGraph g;
+	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> oldPoses;
+	for (const auto& [id, kf] : m_map.keyframes())
+	{
+		oldPoses[id] = kf.T_world_cam;
+		g.addVertex(id, toIsometry(kf.T_world_cam));
+	}
+	auto rel = [&](sfm::KeyFrameId a, sfm::KeyFrameId b) { return g.pose(a).inverse() * g.pose(b); };
+	std::optional<sfm::KeyFrameId> prev;
+	for (const auto& [id, kf] : m_map.keyframes())
+	{
+		if (prev) g.addEdge({*prev, id, rel(*prev, id), loop::Matrix6d::Identity(), loop::EdgeKind::Odometry});
+		for (const auto& [other, w] : kf.covisibility)
+			if (other < id && w >= m_opts.covisibilityEdgeMinWeight && (!prev || other != *prev))
+				g.addEdge({other, id, rel(other, id), loop::Matrix6d::Identity(), loop::EdgeKind::Covisibility});
+		prev = id;
+	}
+	g.addEdge({cand, cur, T_cand_cur, loop::Matrix6d::Identity(), loop::EdgeKind::Loop});
+	// Gauge: keyframe 0 defines the world frame; the loop only bends the rest onto it.
+	g.setFixed(m_map.keyframes().begin()->first);
+	const auto summary = g.optimize(m_opts.poseGraph);
+
+	LoopClosureEvent ev;
+	ev.keyframe = cur;
+	ev.loopKeyFrame = cand;
+	if (!summary.usable) return ev;
+	std::map<sfm::KeyFrameId, Eigen::Isometry3d> oldIso, newIso;
+	for (const auto& c : summary.corrections)
+	{
+		oldIso[c.id] = c.T_world_kf_old;
+		newIso[c.id] = c.T_world_kf_new;
+		m_map.keyframe(c.id).T_world_cam = toCPose3D(c.T_world_kf_new);
+		ev.newPoses[c.id] = m_map.keyframe(c.id).T_world_cam;
+	}
+	// Landmarks follow the keyframe that created them (or their first observer).
+	std::vector<std::pair<sfm::LandmarkId, Eigen::Vector3d>> moved;
+	for (const auto& [id, lm] : m_map.landmarks())
+	{
+		sfm::KeyFrameId ref = lm.firstKeyFrame;
+		if (!newIso.count(ref)) ref = lm.observations.begin()->first;
+		if (!newIso.count(ref)) continue;
+		moved.emplace_back(id, loop::movePointWithKeyFrame(lm.p_world, oldIso[ref], newIso[ref]));
+	}
+	for (const auto& [id, p] : moved) m_map.landmark(id).p_world = p;
+	ev.correctionMetres = (newIso[cur].translation() - oldIso[cur].translation()).norm();
+
+	// Join both sides: the loop keyframe's neighbourhood landmarks into the current one's.
+	std::set<sfm::LandmarkId> loopSide;
+	std::vector<sfm::KeyFrameId> loopGroup = {cand}, curGroup = {cur};
+	for (auto n : m_map.bestCovisibles(cand, 5)) loopGroup.push_back(n);
+	for (auto n : m_map.bestCovisibles(cur, 5)) curGroup.push_back(n);
+	for (auto id : loopGroup)
+		for (auto l : m_map.keyframe(id).landmarks)
+			if (l != sfm::kNoLandmark) loopSide.insert(l);
+	const std::vector<sfm::LandmarkId> lms(loopSide.begin(), loopSide.end());
+	for (auto id : curGroup)
+		if (m_map.hasKeyFrame(id)) m_mapper.fuseLandmarks(id, lms, K);
+	for (auto id : curGroup)
+		if (m_map.hasKeyFrame(id)) m_map.updateCovisibility(id);
+	m_lastGraph = g;
+	return ev;
+}
+
+std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::size_t frameIndex, const sfm::PinholeIntrinsics& K)
+{
+	if (!m_opts.enabled || !m_map.hasKeyFrame(kf)) return std::nullopt;
+	// Keyframes culled by local mapping leave the database.
+	for (auto it = m_dbIds.begin(); it != m_dbIds.end();)
+		if (!m_map.hasKeyFrame(*it))
+		{
+			m_db.erase(*it);
+			it = m_dbIds.erase(it);
+		}
+		else
+			++it;
+	if (m_vocab.empty())
+	{
+		trainIfReady();
+		return std::nullopt;
+	}
+	const auto t0 = std::chrono::steady_clock::now();
+	const loop::BowVector bow = m_vocab.transform(m_map.keyframe(kf).features.descriptors);
+	double score = 0;
+	std::optional<LoopClosureEvent> out;
+	// No detection right after a loop: the map around it is still being joined.
+	if (!m_anyLoop || kf > m_lastLoopKf + 5)
+		if (auto cand = detect(kf, bow, score))
+		{
+			Eigen::Isometry3d T_cand_cur = Eigen::Isometry3d::Identity();
+			int inliers = 0;
+			const bool verified = verify(kf, *cand, K, T_cand_cur, inliers);
+			if (verified && !plausible(kf, *cand, T_cand_cur))
+				rejectedImplausible++;
+			else if (verified)
+			{
+				auto ev = correct(kf, *cand, T_cand_cur, K);
+				if (!ev.newPoses.empty())
+				{
+					ev.frameIndex = frameIndex;
+					ev.score = score;
+					ev.inliers = inliers;
+					ev.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+					m_lastLoopKf = kf;
+					m_anyLoop = true;
+					m_consistency.reset();
+					out = ev;
+				}
+			}
+		}
+	m_db.add(kf, bow);
+	m_dbIds.insert(kf);
+	return out;
+}
+
+}  // namespace keygrid::slam
