@@ -21,6 +21,10 @@ bool haveSharedData(const std::string& sub = "");
 std::string mrptDatasetsDir();
 std::string toolPath(const std::string& tool);
 std::string scratchDir(const std::string& name);
+/** Whole content of a text file ("" if unreadable). */
+std::string readTextFile(const std::string& path);
+/** The number after `"key": ` in a JSON text, NaN when absent (so any comparison fails). */
+double jsonNumber(const std::string& json, const std::string& key);
 /** Runs a shell command, returns its exit status; stdout+stderr go to *output when given. */
 int runCommand(const std::string& cmd, std::string* output = nullptr);
 

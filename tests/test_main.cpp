@@ -4,6 +4,9 @@
 #include <mrpt/system/filesystem.h>
 
 #include <array>
+#include <fstream>
+#include <limits>
+#include <regex>
 #include <cstdio>
 #include <cstdlib>
 #include <sys/wait.h>
@@ -35,6 +38,20 @@ std::string scratchDir(const std::string& name)
 	mrpt::system::createDirectory(std::string(KEYGRID_BINARY_DIR) + "/test-scratch");
 	mrpt::system::createDirectory(d);
 	return d;
+}
+
+std::string readTextFile(const std::string& path)
+{
+	std::ifstream f(path);
+	return {std::istreambuf_iterator<char>(f), {}};
+}
+
+double jsonNumber(const std::string& json, const std::string& key)
+{
+	std::smatch m;
+	if (!std::regex_search(json, m, std::regex("\"" + key + "\": ([-0-9.eE+]+)")))
+		return std::numeric_limits<double>::quiet_NaN();
+	return std::stod(m[1]);
 }
 
 int runCommand(const std::string& cmd, std::string* output)

@@ -9,22 +9,6 @@
 
 using keygrid::test::runCommand;
 
-namespace
-{
-double jsonNumber(const std::string& json, const std::string& key)
-{
-	const std::regex re("\"" + key + "\": ([-0-9.eE+]+)");
-	std::smatch m;
-	if (!std::regex_search(json, m, re)) throw std::runtime_error("no key " + key + " in " + json);
-	return std::stod(m[1]);
-}
-std::string readAll(const std::string& p)
-{
-	std::ifstream f(p);
-	return {std::istreambuf_iterator<char>(f), {}};
-}
-}  // namespace
-
 TEST(EvalTool, GroundTruthAgainstItselfIsZeroAndNoiseRmseIsRecovered)
 {
 	const std::string dir = keygrid::test::scratchDir("eval_tool");
@@ -50,14 +34,14 @@ TEST(EvalTool, GroundTruthAgainstItselfIsZeroAndNoiseRmseIsRecovered)
 	const std::string tool = keygrid::test::toolPath("keygrid-eval");
 	std::string out;
 	ASSERT_EQ(runCommand(tool + " --gt " + dir + "/gt.txt --est " + dir + "/gt.txt --json " + dir + "/self.json", &out), 0) << out;
-	const std::string self = readAll(dir + "/self.json");
-	EXPECT_NEAR(jsonNumber(self, "ate_rmse_m"), 0.0, 1e-9);
-	EXPECT_EQ(jsonNumber(self, "matched"), 1500);
-	EXPECT_NEAR(jsonNumber(self, "rpe_trans_m_per_s"), 0.0, 1e-9);
+	const std::string self = keygrid::test::readTextFile(dir + "/self.json");
+	EXPECT_NEAR(keygrid::test::jsonNumber(self, "ate_rmse_m"), 0.0, 1e-9);
+	EXPECT_EQ(keygrid::test::jsonNumber(self, "matched"), 1500);
+	EXPECT_NEAR(keygrid::test::jsonNumber(self, "rpe_trans_m_per_s"), 0.0, 1e-9);
 	EXPECT_NE(out.find("ATE rmse 0.000000 m"), std::string::npos) << out;
 
 	ASSERT_EQ(runCommand(tool + " --gt " + dir + "/gt.txt --est " + dir + "/est.txt --json " + dir + "/n.json", &out), 0) << out;
-	EXPECT_NEAR(jsonNumber(readAll(dir + "/n.json"), "ate_rmse_m"), std::sqrt(sq / 1500), 1e-4);
+	EXPECT_NEAR(keygrid::test::jsonNumber(keygrid::test::readTextFile(dir + "/n.json"), "ate_rmse_m"), std::sqrt(sq / 1500), 1e-4);
 }
 
 TEST(EvalTool, BadInputsGiveOneLineReasons)

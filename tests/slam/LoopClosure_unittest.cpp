@@ -10,15 +10,6 @@
 
 using namespace keygrid;
 
-namespace
-{
-std::string readAll(const std::string& p)
-{
-	std::ifstream f(p);
-	return {std::istreambuf_iterator<char>(f), {}};
-}
-}  // namespace
-
 TEST(LoopClosure, GeneratedRoomLoopIsClosed)
 {
 	const std::string dir = test::scratchDir("loop_room");
@@ -38,7 +29,7 @@ TEST(LoopClosure, GeneratedRoomLoopIsClosed)
 	ASSERT_TRUE(r.ateRmse.has_value());
 	// Measured 3.7 mm with the loop closed (2026-11-21).
 	EXPECT_LT(*r.ateRmse, 0.01);
-	const std::string js = readAll(o.output + "/report.json");
+	const std::string js = test::readTextFile(o.output + "/report.json");
 	std::smatch m;
 	ASSERT_TRUE(std::regex_search(js, m, std::regex("\"loop_closures\": \\[\\{\"frame\": (\\d+), \"keyframe\": (\\d+), \"loop_keyframe\": (\\d+)")))
 		<< js;
@@ -57,6 +48,6 @@ TEST(LoopClosure, NoLoopClaimedOnRealFramesWithoutOne)
 	o.output = test::scratchDir("loop_rpy");
 	o.quiet = true;
 	slam::runSlam(o);
-	const std::string js = readAll(o.output + "/report.json");
+	const std::string js = test::readTextFile(o.output + "/report.json");
 	EXPECT_NE(js.find("\"loop_closures\": []"), std::string::npos) << js;
 }

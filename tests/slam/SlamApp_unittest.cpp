@@ -13,17 +13,6 @@ using namespace keygrid;
 
 namespace
 {
-std::string readAll(const std::string& p)
-{
-	std::ifstream f(p);
-	return {std::istreambuf_iterator<char>(f), {}};
-}
-double jsonNumber(const std::string& json, const std::string& key)
-{
-	std::smatch m;
-	if (!std::regex_search(json, m, std::regex("\"" + key + "\": ([-0-9.eE+]+)"))) return -1;
-	return std::stod(m[1]);
-}
 std::string rpy() { return test::sharedDataDir() + "/tum_fr1_rpy_first250"; }
 }  // namespace
 
@@ -48,11 +37,11 @@ TEST(SlamApp, TracksRealFr1RpyFramesWithinAteBound)
 	EXPECT_LT(*r.ateRmse, 0.045);
 	const auto traj = core::readTumTrajectory(o.output + "/trajectory.txt");
 	EXPECT_EQ(traj.size(), 120u);
-	const std::string js = readAll(o.output + "/report.json");
-	EXPECT_EQ(jsonNumber(js, "frames"), 120);
-	EXPECT_GT(jsonNumber(js, "keyframes"), 2);
-	EXPECT_GT(jsonNumber(js, "landmarks"), 500);
-	EXPECT_NEAR(jsonNumber(js, "ate_rmse_m"), *r.ateRmse, 1e-6);
+	const std::string js = test::readTextFile(o.output + "/report.json");
+	EXPECT_EQ(test::jsonNumber(js, "frames"), 120);
+	EXPECT_GT(test::jsonNumber(js, "keyframes"), 2);
+	EXPECT_GT(test::jsonNumber(js, "landmarks"), 500);
+	EXPECT_NEAR(test::jsonNumber(js, "ate_rmse_m"), *r.ateRmse, 1e-6);
 	EXPECT_NE(js.find("\"median_ms\""), std::string::npos);
 	EXPECT_NE(js.find("\"p95_ms\""), std::string::npos);
 }
@@ -71,7 +60,7 @@ TEST(SlamApp, SequentialRunsAreIdenticalAndThreadedMatches)
 		o.quiet = true;
 		if (i == 2) o.modeOverride = "threaded";
 		slam::runSlam(o);
-		outs[i] = readAll(o.output + "/trajectory.txt");
+		outs[i] = test::readTextFile(o.output + "/trajectory.txt");
 	}
 	ASSERT_FALSE(outs[0].empty());
 	EXPECT_EQ(outs[0], outs[1]) << "two sequential runs differ";
@@ -95,7 +84,7 @@ TEST(SlamApp, ConvertedRawlogGivesTheSameTrajectoryAsTheTumFolder)
 		o.quiet = true;
 		const auto r = slam::runSlam(o);
 		EXPECT_EQ(r.tracked, 9u);
-		traj[i] = readAll(o.output + "/trajectory.txt");
+		traj[i] = test::readTextFile(o.output + "/trajectory.txt");
 	}
 	// Depth is bit-exact through the rawlog, so the estimate is too (timestamps: 1 us rounding).
 	EXPECT_EQ(traj[0], traj[1]);
@@ -136,6 +125,6 @@ TEST(SlamApp, RealKinectRawlogFrameInitialisesTheMap)
 	EXPECT_TRUE(r.error.empty()) << r.error;
 	EXPECT_EQ(r.frames, 1u);
 	EXPECT_EQ(r.tracked, 1u);
-	const std::string js = readAll(o.output + "/report.json");
-	EXPECT_GT(jsonNumber(js, "landmarks"), 300);
+	const std::string js = test::readTextFile(o.output + "/report.json");
+	EXPECT_GT(test::jsonNumber(js, "landmarks"), 300);
 }

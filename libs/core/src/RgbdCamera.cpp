@@ -1,3 +1,4 @@
+#include <keygrid/core/ConfigReading.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -53,24 +54,7 @@ RgbdCamera RgbdCamera::Preset(const std::string& n)
 void RgbdCamera::loadFromConfigFile(
 	const mrpt::config::CConfigFileBase& cfg, const std::string& s)
 {
-	auto num = [&](const char* key, double cur) {
-		const std::string v = cfg.read_string(s, key, "", false);
-		if (v.empty()) return cur;
-		std::size_t used = 0;
-		double out = 0;
-		try
-		{
-			out = std::stod(v, &used);
-		}
-		catch (const std::exception&)
-		{
-			used = 0;
-		}
-		if (used == 0 || !std::isfinite(out))
-			throw std::invalid_argument(
-				"[" + s + "] " + key + " = '" + v + "' is not a finite number");
-		return out;
-	};
+	auto num = [&](const char* key, double cur) { return readFiniteNumber(cfg, s, key, cur); };
 	name = cfg.read_string(s, "name", name, false);
 	fx = num("fx", fx);
 	fy = num("fy", fy);

@@ -1,5 +1,7 @@
 #include "IniHelpers.h"
 
+#include <keygrid/core/TumText.h>
+
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -28,18 +30,8 @@ std::vector<double> numbers(const std::string& s, const std::string& k, const st
 	std::string tok;
 	while (is >> tok)
 	{
-		std::size_t used = 0;
 		double x = 0;
-		try
-		{
-			x = std::stod(tok, &used);
-		}
-		catch (const std::exception&)
-		{
-			used = 0;
-		}
-		if (used != tok.size() || !std::isfinite(x))
-			fail(s, k, v, "'" + tok + "' is not a finite number");
+		if (!core::parseDouble(tok, x)) fail(s, k, v, "'" + tok + "' is not a finite number");
 		out.push_back(x);
 	}
 	return out;

@@ -3,6 +3,7 @@
  * Private helpers of the 3D grid options: strict INI number parsing and range errors that name
  * the key and the offending value.
  */
+#include <keygrid/core/ConfigReading.h>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <cmath>
@@ -18,23 +19,7 @@ inline double readNumber(
 	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key,
 	double current)
 {
-	const std::string v = cfg.read_string(section, key, "", false);
-	if (v.empty()) return current;
-	std::size_t used = 0;
-	double out = 0;
-	try
-	{
-		out = std::stod(v, &used);
-	}
-	catch (const std::exception&)
-	{
-		used = 0;
-	}
-	while (used < v.size() && std::isspace(static_cast<unsigned char>(v[used]))) ++used;
-	if (used != v.size() || !std::isfinite(out))
-		throw std::invalid_argument(
-			"[" + section + "] " + key + " = '" + v + "' is not a finite number");
-	return out;
+	return core::readFiniteNumber(cfg, section, key, current);
 }
 
 /** Reads a boolean (true/false/1/0/yes/no); anything else throws naming key and value. */
