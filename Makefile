@@ -7,7 +7,7 @@ ASAN_DIR  ?= build-asan
 JOBS      ?= 2
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure build test demo sanitize test-sanitize clean
+.PHONY: all deps configure build test demo sanitize test-sanitize ini-reference clean
 
 all: build
 
@@ -35,6 +35,12 @@ sanitize: deps
 test-sanitize: sanitize
 	ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  ctest --test-dir $(ASAN_DIR) --output-on-failure -j$(JOBS)
+
+# doc/ini-reference.md from the options structs (checked by the test IniReference.MatchesCommittedFile).
+ini-reference: configure
+	cmake --build $(BUILD_DIR) -j$(JOBS) --target keygrid-slam
+	$(BUILD_DIR)/bin/keygrid-slam --ini-reference > doc/ini-reference.md.tmp
+	mv doc/ini-reference.md.tmp doc/ini-reference.md
 
 clean:
 	rm -rf $(BUILD_DIR) $(ASAN_DIR)

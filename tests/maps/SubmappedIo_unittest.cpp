@@ -34,6 +34,7 @@ CSubmappedOccupancyGrid3D twoSubmapMap()
 	m.insertionOptions.storeKeyframeDepth = true;
 	m.insertionOptions.integration.logOddsHit = 0.9f;
 	m.morphingOptions.weightExponent = 3.0;
+	m.morphingOptions.interpolation = MorphingOptions::Interpolation::Nearest;
 	m.likelihoodOptions.decimation = 7;
 	const auto cam = test::smallCamera();
 	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(), 0.0, 1);
@@ -85,11 +86,12 @@ TEST(SubmappedIo, SerializationRoundTrip)
 	EXPECT_TRUE(r->insertionOptions.storeKeyframeDepth);
 	EXPECT_EQ(r->insertionOptions.conflict.conflictMinVoxels, 100);
 	EXPECT_EQ(r->morphingOptions.weightExponent, 3.0);
+	EXPECT_EQ(r->morphingOptions.interpolation, MorphingOptions::Interpolation::Nearest);
 	EXPECT_EQ(r->likelihoodOptions.decimation, 7u);
 
 	Probe p;
 	buf.Seek(0);
-	EXPECT_ANY_THROW(p.read(arch, 1));
+	EXPECT_ANY_THROW(p.read(arch, 2));
 }
 
 TEST(SubmappedIo, CreatedFromIniThroughCMultiMetricMap)
@@ -105,6 +107,7 @@ pixelDecimation=2
 travelledDistanceThreshold=2.5
 storeKeyframeDepth=true
 morphWeightExponent=3
+morphInterpolation=nearest
 [map_submappedOccupancyGrid3D_00_likelihoodOpts]
 decimation=5
 )";
@@ -122,6 +125,7 @@ decimation=5
 	EXPECT_DOUBLE_EQ(m->insertionOptions.conflict.travelledDistanceThreshold, 2.5);
 	EXPECT_TRUE(m->insertionOptions.storeKeyframeDepth);
 	EXPECT_DOUBLE_EQ(m->morphingOptions.weightExponent, 3.0);
+	EXPECT_EQ(m->morphingOptions.interpolation, MorphingOptions::Interpolation::Nearest);
 	EXPECT_EQ(m->likelihoodOptions.decimation, 5u);
 
 	// Options save / load round trip and errors naming the key.
@@ -145,6 +149,18 @@ decimation=5
 	{
 		EXPECT_NE(std::string(e.what()).find("maxRange"), std::string::npos) << e.what();
 		EXPECT_NE(std::string(e.what()).find("four"), std::string::npos) << e.what();
+	}
+	mrpt::config::CConfigFileMemory badInterp(
+		"[map_submappedOccupancyGrid3D_00_insertOpts]\nmorphInterpolation=cubic\n");
+	try
+	{
+		def.loadFromConfigFile(badInterp, "map_submappedOccupancyGrid3D_00");
+		FAIL() << "an unknown morphInterpolation must throw";
+	}
+	catch (const std::exception& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("morphInterpolation"), std::string::npos) << e.what();
+		EXPECT_NE(std::string(e.what()).find("cubic"), std::string::npos) << e.what();
 	}
 }
 

@@ -26,6 +26,11 @@ PrefetchingFrameSource::PrefetchingFrameSource(std::unique_ptr<FrameSource> inne
 				it.error = e.what();
 			}
 			it.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+			if (m_inner->skippedCount() != m_innerSkipped.load())
+			{
+				std::lock_guard<std::mutex> lk(m_skipMutex);
+				m_innerLastSkip = m_inner->lastSkipReason();
+			}
 			m_innerSkipped = m_inner->skippedCount();
 			if (!more && it.error.empty()) break;
 			const bool stop = !it.error.empty();

@@ -11,10 +11,25 @@
 
 #include <deque>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
 namespace keygrid::core
 {
+namespace
+{
+/** One line out of a (nested, multi-line) MRPT exception text: its innermost "Message:". */
+std::string innermostReason(const std::string& what)
+{
+	const auto m = what.rfind("Message:");
+	std::string line = m == std::string::npos ? what : what.substr(m + 8);
+	line = line.substr(0, line.find('\n'));
+	const auto b = line.find_first_not_of(" \t");
+	line = b == std::string::npos ? std::string() : line.substr(b);
+	return line.size() > 300 ? line.substr(0, 300) : line;
+}
+}  // namespace
+
 struct RawlogFrameSource::Impl
 {
 	mrpt::io::CFileGZInputStream file;
@@ -31,6 +46,12 @@ RawlogFrameSource::RawlogFrameSource(const std::string& path)
 	if (!m_impl->file.open(path))
 		throw std::runtime_error("cannot open rawlog '" + path + "'");
 	m_fileSize = mrpt::system::getFileSize(path);
+	{
+		std::ifstream magic(path, std::ios::binary);
+		unsigned char b[2] = {0, 0};
+		magic.read(reinterpret_cast<char*>(b), 2);
+		m_compressed = b[0] == 0x1f && b[1] == 0x8b;
+	}
 	// External (lazy-load) images are stored relative to <name>_Images/ (rawlog-grabber and
 	// RawlogWriter) or, in older rawlogs, Images/ beside the file.
 	const std::filesystem::path p(path);
@@ -66,14 +87,14 @@ bool RawlogFrameSource::next(Frame& out)
 			catch (const std::exception& e)
 			{
 				noteSkip(
-					"rawlog entry " + std::to_string(m_impl->entry) +
+					"rawlog entry " + std::to_string(m_impl->entry - 1) +
 					": cannot load external image: " + e.what());
 				continue;
 			}
 			std::string why;
 			if (!frameFromObservation(*obs, out, &why))
 			{
-				noteSkip("rawlog entry " + std::to_string(m_impl->entry) + ": " + why);
+				noteSkip("rawlog entry " + std::to_string(m_impl->entry - 1) + ": " + why);
 				continue;
 			}
 			obs->unload();
@@ -82,29 +103,39 @@ bool RawlogFrameSource::next(Frame& out)
 		}
 		if (m_impl->eof) return false;
 
-		CActionCollection::Ptr actions;
-		CSensoryFrame::Ptr sf;
-		CObservation::Ptr obs;
-		std::size_t idx = m_impl->entry;
-		bool ok = false;
+		// Objects are read one by one rather than through CRawlog::getActionObservationPairOrObservation,
+		// which reports a truncated or corrupt file as a normal end of file.
+		mrpt::serialization::CSerializable::Ptr obj;
+		const std::size_t posBefore = m_impl->file.getPosition();
 		try
 		{
 			auto arch = mrpt::serialization::archiveFrom(m_impl->file);
-			ok = CRawlog::getActionObservationPairOrObservation(arch, actions, sf, obs, idx);
+			obj = arch.ReadObject();
+		}
+		catch (const mrpt::serialization::CExceptionEOF&)
+		{
+			m_impl->eof = true;
+			// Nothing left: the end. Bytes left that do not make an object header: truncated.
+			// (gzip rawlogs count positions in uncompressed bytes: no such check there.)
+			if (m_compressed || posBefore >= m_fileSize) continue;
+			throw std::runtime_error(
+				"rawlog '" + m_path + "' is corrupt or truncated after entry " + std::to_string(m_impl->entry) +
+				": incomplete object header at byte " + std::to_string(posBefore));
 		}
 		catch (const std::exception& e)
 		{
 			m_impl->eof = true;
 			throw std::runtime_error(
 				"rawlog '" + m_path + "' is corrupt or truncated after entry " +
-				std::to_string(m_impl->entry) + ": " + std::string(e.what()).substr(0, 300));
+				std::to_string(m_impl->entry) + ": " + innermostReason(e.what()));
 		}
 		m_impl->entry++;
-		if (!ok)
-		{
-			m_impl->eof = true;
-			continue;
-		}
+		CSensoryFrame::Ptr sf = std::dynamic_pointer_cast<CSensoryFrame>(obj);
+		CObservation::Ptr obs = std::dynamic_pointer_cast<CObservation>(obj);
+		if (!sf && !obs && !std::dynamic_pointer_cast<CActionCollection>(obj))
+			noteSkip(
+				"rawlog entry " + std::to_string(m_impl->entry - 1) + ": unexpected object " +
+				(obj ? std::string(obj->GetRuntimeClass()->className) : std::string("(null)")));
 		auto take = [&](const CObservation::Ptr& o) {
 			if (auto s = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
 				m_impl->pending.push_back(s);

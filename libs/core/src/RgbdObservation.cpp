@@ -117,8 +117,30 @@ bool frameFromObservation(
 			std::to_string(obs.intensityImage.getHeight()) + " and range image " +
 			std::to_string(cols) + "x" + std::to_string(rows) + " differ in size");
 
+	// Calibrations that disagree with the images (or hold NaN) would index outside the images
+	// later: reject the observation here, saying why.
+	const RgbdCamera intensityCam = RgbdCamera::FromTCamera(obs.cameraParamsIntensity, obs.rangeUnits);
+	std::string err;
+	if (!intensityCam.isValid(&err)) return fail("invalid intensity camera parameters: " + err);
+	if (intensityCam.width != obs.intensityImage.getWidth() || intensityCam.height != obs.intensityImage.getHeight())
+		return fail(
+			"intensity camera parameters are for " + std::to_string(intensityCam.width) + "x" +
+			std::to_string(intensityCam.height) + " but the image is " +
+			std::to_string(obs.intensityImage.getWidth()) + "x" + std::to_string(obs.intensityImage.getHeight()));
+	const bool registered = obs.doDepthAndIntensityCamerasCoincide() && obs.cameraParams == obs.cameraParamsIntensity;
+	if (!registered)
+	{
+		const RgbdCamera depthCam = RgbdCamera::FromTCamera(obs.cameraParams, obs.rangeUnits);
+		// (Its width/height may differ from the range image's: Kinect calibrations often say 640x488.)
+		if (!depthCam.isValid(&err)) return fail("invalid depth camera parameters: " + err);
+		const auto H = obs.relativePoseIntensityWRTDepth.getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>();
+		for (int r = 0; r < 3; r++)
+			for (int c = 0; c < 4; c++)
+				if (!std::isfinite(H(r, c))) return fail("relativePoseIntensityWRTDepth is not finite");
+	}
+
 	out.timestamp = mrpt::Clock::toDouble(obs.timestamp);
-	out.camera = RgbdCamera::FromTCamera(obs.cameraParamsIntensity, obs.rangeUnits);
+	out.camera = intensityCam;
 	out.depthRaw.create(rows, cols, CV_16UC1);
 	for (int r = 0; r < rows; r++)
 	{
@@ -126,7 +148,7 @@ bool frameFromObservation(
 		for (int c = 0; c < cols; c++) o[c] = obs.rangeImage(r, c);
 	}
 	// Unregistered sensors (raw Kinect): bring depth into the colour camera, where the frame lives.
-	if (!obs.doDepthAndIntensityCamerasCoincide() || !(obs.cameraParams == obs.cameraParamsIntensity))
+	if (!registered)
 		out.depthRaw = registerDepthToIntensity(
 			out.depthRaw, obs.rangeUnits, obs.cameraParams, obs.cameraParamsIntensity,
 			obs.relativePoseIntensityWRTDepth);

@@ -2,6 +2,9 @@
 #include <keygrid/eval/TrajectoryErrors.h>
 #include <mrpt/core/bits_math.h>
 
+#include <Eigen/LU>
+#include <Eigen/SVD>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -76,6 +79,31 @@ TrajectoryErrors evaluateTrajectory(
 	for (std::size_t k = 0; k < x.size(); k++) ate.push_back((out.alignment.apply(x[k]) - y[k]).norm());
 	out.ate = ErrorStats::Of(ate);
 
+	// --- Orientation: R_a = argmin sum_k |R_gt_k - R_a R_est_k|_F^2 = polar(sum_k R_gt_k R_est_k^T)
+	// (U V^T of its SVD, det fixed to +1), then the angle of each residual rotation.
+	{
+		Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+		std::vector<std::pair<Eigen::Matrix3d, Eigen::Matrix3d>> rots;
+		for (const auto& [i, j] : matches)
+		{
+			const Eigen::Matrix3d Re = est[i].T_world_cam.getRotationMatrix().asEigen();
+			const Eigen::Matrix3d Rg = gt[j].T_world_cam.getRotationMatrix().asEigen();
+			M += Rg * Re.transpose();
+			rots.emplace_back(Rg, Re);
+		}
+		Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+		Eigen::Matrix3d W = Eigen::Matrix3d::Identity();
+		if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) W(2, 2) = -1;
+		const Eigen::Matrix3d Ra = svd.matrixU() * W * svd.matrixV().transpose();
+		std::vector<double> angles;
+		for (const auto& [Rg, Re] : rots)
+		{
+			const Eigen::Matrix3d E = Rg.transpose() * Ra * Re;
+			angles.push_back(mrpt::RAD2DEG(std::acos(std::clamp((E.trace() - 1.0) / 2.0, -1.0, 1.0))));
+		}
+		out.ateRotDeg = ErrorStats::Of(angles);
+	}
+
 	// --- RPE: for each matched pose i, the matched pose j closest to t_i + delta;
 	// E = inv(inv(G_i) G_j) * inv(E_i) E_j, errors |trans(E)| and angle(E) per delta seconds.
 	std::vector<double> rt, rr;
@@ -141,6 +169,7 @@ std::string TrajectoryErrors::toJson() const
 	o << "  \"ate_std_m\": " << num(ate.stddev) << ",\n";
 	o << "  \"ate_min_m\": " << num(ate.min) << ",\n";
 	o << "  \"ate_max_m\": " << num(ate.max) << ",\n";
+	o << "  \"ate_rot_rmse_deg\": " << num(ateRotDeg.rmse) << ",\n";
 	o << "  \"rpe_trans_m_per_s\": " << (rpeTrans ? num(rpeTrans->rmse) : "null") << ",\n";
 	o << "  \"rpe_rot_deg_per_s\": " << (rpeRotDeg ? num(rpeRotDeg->rmse) : "null") << ",\n";
 	o << "  \"rpe_pairs\": " << (rpeTrans ? rpeTrans->count : 0) << ",\n";

@@ -4,6 +4,7 @@
  */
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <mrpt/img/CImage.h>
+#include <mrpt/math/CQuaternion.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -162,6 +163,15 @@ void CISMOccupancyGrid2D::saveAsRosMapServer(const std::string& yamlPath) const
 	std::ofstream yaml(yamlPath);
 	if (!yaml) throw std::runtime_error("cannot write '" + yamlPath + "'");
 	char buf[512];
+	// The floor frame in the world (a comment: map_server and MRPT ignore it), so that a map
+	// whose floor was estimated can be compared with a ground truth in another frame. First
+	// line: libfyaml 0.8 (MRPT's YAML reader) leaks its input buffer on a trailing comment.
+	mrpt::math::CQuaternionDouble q;
+	const auto& F = floorPose();
+	F.getAsQuaternion(q);
+	std::snprintf(buf, sizeof(buf), "# keygrid T_world_floor (x y z qx qy qz qw): %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
+		F.x(), F.y(), F.z(), q.x(), q.y(), q.z(), q.r());
+	yaml << buf;
 	std::snprintf(buf, sizeof(buf),
 		"image: %s\nresolution: %.9g\norigin: [%.9g, %.9g, 0.0]\nnegate: 0\n"
 		"occupied_thresh: 0.65\nfree_thresh: 0.196\n",

@@ -1,6 +1,8 @@
 /** \file CSubmappedOccupancyGrid3D_insert.cpp
  * Integration of depth frames and MRPT observations; the observation likelihood.
  */
+#include "detail/DepthOfScan.h"
+
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -65,36 +67,6 @@ CSubmappedOccupancyGrid3D::InsertResult CSubmappedOccupancyGrid3D::insertDepthFr
 	return r;
 }
 
-namespace
-{
-/** Depth image [m] and camera of a 3D range scan (range image converted to depth along the
- * optical axis when the scan stores Euclidean ranges). */
-bool depthOfScan(const mrpt::obs::CObservation3DRangeScan& o, cv::Mat& depth, core::RgbdCamera& cam)
-{
-	o.load();
-	if (!o.hasRangeImage || o.rangeImage.rows() == 0) return false;
-	cam = core::RgbdCamera::FromTCamera(o.cameraParams, o.rangeUnits);
-	const int rows = static_cast<int>(o.rangeImage.rows()), cols = static_cast<int>(o.rangeImage.cols());
-	cam.width = static_cast<unsigned>(cols);
-	cam.height = static_cast<unsigned>(rows);
-	depth.create(rows, cols, CV_32FC1);
-	for (int r = 0; r < rows; ++r)
-	{
-		float* d = depth.ptr<float>(r);
-		for (int c = 0; c < cols; ++c)
-		{
-			float z = o.rangeImage(r, c) * o.rangeUnits;
-			if (!o.range_is_depth && z > 0)
-			{
-				const double xn = (c - cam.cx) / cam.fx, yn = (r - cam.cy) / cam.fy;
-				z = static_cast<float>(z / std::sqrt(1.0 + xn * xn + yn * yn));
-			}
-			d[c] = z;
-		}
-	}
-	return true;
-}
-}  // namespace
 
 bool CSubmappedOccupancyGrid3D::internal_insertObservation(
 	const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
@@ -103,7 +75,7 @@ bool CSubmappedOccupancyGrid3D::internal_insertObservation(
 	if (!scan) return false;
 	cv::Mat depth;
 	core::RgbdCamera cam;
-	if (!depthOfScan(*scan, depth, cam)) return false;
+	if (!detail::depthOfScan(*scan, depth, cam)) return false;
 
 	const mrpt::poses::CPose3D T_world_robot = robotPose ? *robotPose : mrpt::poses::CPose3D();
 	const mrpt::poses::CPose3D T_world_cam =
@@ -136,7 +108,7 @@ double CSubmappedOccupancyGrid3D::internal_computeObservationLikelihood(
 	if (!scan) return 0.0;
 	cv::Mat depth;
 	core::RgbdCamera cam;
-	if (!depthOfScan(*scan, depth, cam)) return 0.0;
+	if (!detail::depthOfScan(*scan, depth, cam)) return 0.0;
 	const mrpt::poses::CPose3D T_world_cam =
 		core::cameraPoseFromSensorPose(takenFrom + scan->sensorPose);
 	const unsigned dec = likelihoodOptions.decimation;

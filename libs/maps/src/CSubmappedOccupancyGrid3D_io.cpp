@@ -93,7 +93,9 @@ void readGrid(CArchive& in, VoxelBlockGrid& g)
 }
 }  // namespace
 
-uint8_t CSubmappedOccupancyGrid3D::serializeGetVersion() const { return 0; }
+// Version 1 (2026-11-21) adds morphingOptions.interpolation after morphingOptions.threads;
+// version-0 archives load with Nearest, the behaviour they were written with.
+uint8_t CSubmappedOccupancyGrid3D::serializeGetVersion() const { return 1; }
 
 void CSubmappedOccupancyGrid3D::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -111,7 +113,7 @@ void CSubmappedOccupancyGrid3D::serializeTo(mrpt::serialization::CArchive& out) 
 	out << morphingOptions.viewConeMaxRange << morphingOptions.travelWindow
 		<< morphingOptions.weightExponent
 		<< morphingOptions.minWeightDistance << morphingOptions.keepVoxelsOutsideCones
-		<< uint32_t(morphingOptions.threads);
+		<< uint32_t(morphingOptions.threads) << uint8_t(morphingOptions.interpolation);
 	out << uint32_t(likelihoodOptions.decimation) << likelihoodOptions.maxRange
 		<< likelihoodOptions.minProbability;
 	// State.
@@ -149,6 +151,7 @@ void CSubmappedOccupancyGrid3D::serializeFrom(mrpt::serialization::CArchive& in,
 	switch (version)
 	{
 		case 0:
+		case 1:
 		{
 			in >> m_resolution;
 			auto& io = insertionOptions.integration;
@@ -167,6 +170,14 @@ void CSubmappedOccupancyGrid3D::serializeFrom(mrpt::serialization::CArchive& in,
 				morphingOptions.weightExponent >>
 				morphingOptions.minWeightDistance >> morphingOptions.keepVoxelsOutsideCones >> u1;
 			morphingOptions.threads = u1;
+			morphingOptions.interpolation = MorphingOptions::Interpolation::Nearest;
+			if (version >= 1)
+			{
+				uint8_t interp = 0;
+				in >> interp;
+				if (interp > 1) throw std::runtime_error("CSubmappedOccupancyGrid3D: bad morphing interpolation " + std::to_string(interp));
+				morphingOptions.interpolation = static_cast<MorphingOptions::Interpolation>(interp);
+			}
 			in >> u1 >> likelihoodOptions.maxRange >> likelihoodOptions.minProbability;
 			likelihoodOptions.decimation = u1;
 

@@ -108,6 +108,85 @@ void PixelRayTable::update(const core::RgbdCamera& cam)
 	m_valid = true;
 }
 
+namespace
+{
+/** End voxel and flag (0 skip, 1 cut at maxRange, 2 hit) of n pixels with unit-stride depth
+ * `d` [m] and unit-depth rays `xy`, for the pose (R row-major, origin o). The voxel of a cut
+ * pixel is left for the caller (returns whether there is any). Branch-free so that the
+ * compiler can vectorise it: compiled twice below, for the baseline ISA and for AVX2 (chosen
+ * at run time). Both use the same IEEE operations in the same order (no FMA contraction: the
+ * AVX2 variant does not enable FMA), so the results are bit-identical to the scalar per-pixel
+ * code. no-trapping-math lets GCC if-convert the comparisons; it changes no result (only the
+ * guarantee about floating-point exception flags). */
+#define KEYGRID_END_VOXELS_OF_ROW_BODY                                                           \
+	constexpr float kInfF = std::numeric_limits<float>::infinity();                              \
+	int anyCut = 0;                                                                              \
+	for (unsigned c = 0; c < n; ++c)                                                             \
+	{                                                                                            \
+		const float d0 = dsrc[c];                                                                \
+		const int valid = (d0 > 0.0f) & (d0 < kInfF); /* 0, negative, NaN, inf: invalid */      \
+		const float d = valid ? d0 : 1.0f;                                                       \
+		const double x0 = xsrc[2 * c] * d, y0 = xsrc[2 * c + 1] * d, z0 = d;                     \
+		const double range2 = x0 * x0 + y0 * y0 + z0 * z0;                                       \
+		const int cut = range2 > maxR2;                                                          \
+		/* a cut pixel's voxel is redone by the caller: use 0 here (no overflow in the casts) */ \
+		const double x = cut ? 0.0 : x0, y = cut ? 0.0 : y0, z = cut ? 0.0 : z0;                 \
+		const int keep = valid & (range2 >= minR2);                                              \
+		anyCut |= keep & cut;                                                                    \
+		bf[c] = keep * (2 - cut);                                                                \
+		/* floorToInt() spelled out (not inlined across different target options) */           \
+		const double qx = (Rs[0] * x + Rs[1] * y + Rs[2] * z + ox) * inv;                        \
+		const double qy = (Rs[3] * x + Rs[4] * y + Rs[5] * z + oy) * inv;                        \
+		const double qz = (Rs[6] * x + Rs[7] * y + Rs[8] * z + oz) * inv;                        \
+		const int32_t ix = static_cast<int32_t>(qx), iy = static_cast<int32_t>(qy),              \
+					  iz = static_cast<int32_t>(qz);                                             \
+		bx[c] = ix - static_cast<int32_t>(qx < static_cast<double>(ix));                         \
+		by[c] = iy - static_cast<int32_t>(qy < static_cast<double>(iy));                         \
+		bz[c] = iz - static_cast<int32_t>(qz < static_cast<double>(iz));                         \
+	}                                                                                            \
+	return anyCut;
+
+#define KEYGRID_END_VOXELS_OF_ROW_ARGS                                                           \
+	const float *__restrict dsrc, const float *__restrict xsrc, unsigned n,                      \
+		const double *__restrict Rs, double ox, double oy, double oz, double inv, double minR2,  \
+		double maxR2, int32_t *__restrict bx, int32_t *__restrict by, int32_t *__restrict bz,    \
+		int32_t *__restrict bf
+
+#if defined(__GNUC__) && !defined(__clang__)
+#define KEYGRID_NO_TRAPPING_MATH __attribute__((optimize("no-trapping-math")))
+#else
+#define KEYGRID_NO_TRAPPING_MATH
+#endif
+
+KEYGRID_NO_TRAPPING_MATH int endVoxelsOfRowBase(KEYGRID_END_VOXELS_OF_ROW_ARGS)
+{
+	KEYGRID_END_VOXELS_OF_ROW_BODY
+}
+#if defined(__x86_64__) || defined(__i386__)
+#define KEYGRID_HAVE_AVX2_VARIANT 1
+KEYGRID_NO_TRAPPING_MATH __attribute__((target("avx2"))) int endVoxelsOfRowAvx2(
+	KEYGRID_END_VOXELS_OF_ROW_ARGS)
+{
+	KEYGRID_END_VOXELS_OF_ROW_BODY
+}
+#endif
+#undef KEYGRID_END_VOXELS_OF_ROW_BODY
+#undef KEYGRID_END_VOXELS_OF_ROW_ARGS
+#undef KEYGRID_NO_TRAPPING_MATH
+
+using EndVoxelsOfRowFn = int (*)(const float*, const float*, unsigned, const double*, double, double,
+	double, double, double, double, int32_t*, int32_t*, int32_t*, int32_t*);
+EndVoxelsOfRowFn endVoxelsOfRowImpl()
+{
+#ifdef KEYGRID_HAVE_AVX2_VARIANT
+	static const EndVoxelsOfRowFn f = __builtin_cpu_supports("avx2") ? &endVoxelsOfRowAvx2 : &endVoxelsOfRowBase;
+	return f;
+#else
+	return &endVoxelsOfRowBase;
+#endif
+}
+}  // namespace
+
 // ---------------------------------------------------------------- integrator
 DepthFrameIntegrator::DepthFrameIntegrator(const DepthIntegrationOptions& opts) : m_opts(opts)
 {
@@ -157,6 +236,71 @@ FrameVoxelUpdates DepthFrameIntegrator::castFrame(
 		std::vector<EndVoxel>& runs = m_runs[t];
 		VoxelIndex prev{INT32_MIN, 0, 0};
 		uint8_t prevFlag = 0;
+		if (disc)
+		{
+			// Discretized mode, per row: (1) end voxel and flag of every pixel in a branch-free
+			// loop the compiler can vectorise (the rare rays beyond maxRange are redone in
+			// scalar code), (2) runs of equal end voxels collapsed. Arithmetic and results are
+			// those of the per-pixel loop below.
+			std::vector<int32_t> bx(nu), by(nu), bz(nu);
+			std::vector<int32_t> bf(nu);
+			const EndVoxelsOfRowFn endVoxelsOfRow = endVoxelsOfRowImpl();
+			std::vector<float> rowD(dec > 1 ? nu : 0), rowXY(dec > 1 ? 2 * nu : 0);
+			const double Rs[9] = {R[0][0], R[0][1], R[0][2], R[1][0], R[1][1], R[1][2], R[2][0], R[2][1], R[2][2]};
+			const double ox = origin.x, oy = origin.y, oz = origin.z;
+			for (std::size_t r = r0; r < r1; ++r)
+			{
+				const unsigned v = static_cast<unsigned>(r) * dec;
+				const float* drow = depth.ptr<float>(static_cast<int>(v));
+				const float* xy = m_rays.row(v);
+				// Depth and ray of pixel c are drow[c * dec], xy[2 * c * dec]: copied for dec > 1
+				// so that the loop below reads unit-stride arrays.
+				const float* dsrc = drow;
+				const float* xsrc = xy;
+				if (dec > 1)
+				{
+					for (unsigned c = 0; c < nu; ++c)
+					{
+						rowD[c] = drow[c * dec];
+						rowXY[2 * c] = xy[2 * c * dec];
+						rowXY[2 * c + 1] = xy[2 * c * dec + 1];
+					}
+					dsrc = rowD.data();
+					xsrc = rowXY.data();
+				}
+				const int anyCut = endVoxelsOfRow(dsrc, xsrc, nu, Rs, ox, oy, oz, inv, minR2, maxR2,
+					bx.data(), by.data(), bz.data(), bf.data());
+				if (anyCut)
+					for (unsigned c = 0; c < nu; ++c)
+					{
+						if (bf[c] != 1) continue;
+						const unsigned u = c * dec;
+						const float d = drow[u];
+						double x = xy[2 * u] * d, y = xy[2 * u + 1] * d, z = d;
+						const double sc = maxR / std::sqrt(x * x + y * y + z * z);
+						x *= sc, y *= sc, z *= sc;
+						bx[c] = floorToInt((Rs[0] * x + Rs[1] * y + Rs[2] * z + ox) * inv);
+						by[c] = floorToInt((Rs[3] * x + Rs[4] * y + Rs[5] * z + oy) * inv);
+						bz[c] = floorToInt((Rs[6] * x + Rs[7] * y + Rs[8] * z + oz) * inv);
+					}
+				for (unsigned c = 0; c < nu; ++c)
+				{
+					const uint8_t f = static_cast<uint8_t>(bf[c]);
+					if (!f) continue;
+					++e.rays;
+					const VoxelIndex vx{bx[c], by[c], bz[c]};
+					// Runs of pixels ending in the same voxel are recorded once.
+					if (vx == prev && f == prevFlag) continue;
+					prev = vx;
+					prevFlag = f;
+					runs.push_back({vx, f == 2});
+					e.add(vx);
+				}
+			}
+			ext[t] = e;
+			return;
+		}
+		// Per-pixel mode: every pixel's float end point and flag.
 		for (std::size_t r = r0; r < r1; ++r)
 		{
 			const unsigned v = static_cast<unsigned>(r) * dec;
@@ -165,7 +309,7 @@ FrameVoxelUpdates DepthFrameIntegrator::castFrame(
 			for (unsigned c = 0; c < nu; ++c)
 			{
 				const std::size_t i = r * nu + c;
-				if (!disc) m_flags[i] = 0;
+				m_flags[i] = 0;
 				const unsigned u = c * dec;
 				const float d = drow[u];
 				if (!(d > 0.0f && d < kInfF)) continue;  // 0, negative, NaN and inf are invalid
@@ -180,25 +324,14 @@ FrameVoxelUpdates DepthFrameIntegrator::castFrame(
 					f = 1;
 				}
 				++e.rays;
-				double w[3] = {R[0][0] * x + R[0][1] * y + R[0][2] * z + origin.x,
+				const double w[3] = {R[0][0] * x + R[0][1] * y + R[0][2] * z + origin.x,
 					R[1][0] * x + R[1][1] * y + R[1][2] * z + origin.y,
 					R[2][0] * x + R[2][1] * y + R[2][2] * z + origin.z};
-				if (!disc)
-				{
-					// Per-pixel rays end at the float point: take its voxel from the same value.
-					m_flags[i] = f;
-					m_ends[i] = mrpt::math::TPoint3Df(float(w[0]), float(w[1]), float(w[2]));
-					w[0] = m_ends[i].x, w[1] = m_ends[i].y, w[2] = m_ends[i].z;
-				}
-				const VoxelIndex vx{floorToInt(w[0] * inv), floorToInt(w[1] * inv), floorToInt(w[2] * inv)};
-				if (disc)
-				{
-					// Runs of pixels ending in the same voxel are recorded once.
-					if (vx == prev && f == prevFlag) continue;
-					prev = vx;
-					prevFlag = f;
-					runs.push_back({vx, f == 2});
-				}
+				// Per-pixel rays end at the float point: take its voxel from the same value.
+				m_flags[i] = f;
+				m_ends[i] = mrpt::math::TPoint3Df(float(w[0]), float(w[1]), float(w[2]));
+				const VoxelIndex vx{floorToInt(double(m_ends[i].x) * inv), floorToInt(double(m_ends[i].y) * inv),
+					floorToInt(double(m_ends[i].z) * inv)};
 				e.add(vx);
 			}
 		}
@@ -270,6 +403,76 @@ void sortUnique(std::vector<EndVoxel>& e)
 				[](const EndVoxel& a, const EndVoxel& b) { return a.v == b.v; }),
 		e.end());
 }
+
+/** The free marks of one ray on the dense per-frame mark volume (x fastest, strides 1, sy, sz
+ * bytes): every voxel of traverseSegment(a, b) except the last one (the end voxel), which is
+ * exactly what castOne() marks through traverseSegment's visitor. Same arithmetic as
+ * traverseSegment (Dda.h), hence the same voxel sequence, but the volume offset is stepped
+ * incrementally (+-1, +-sy, +-sz) instead of being recomputed from the voxel index per visit.
+ * `a_v` is the origin in voxel units, `aOff` its offset in the volume. Returns the number of
+ * voxels traverseSegment would visit (steps + 1). */
+inline std::size_t markFreeLinear(const double a_v[3], const int32_t aCur[3], std::size_t aOff,
+	const mrpt::math::TPoint3D& b, double inv, std::ptrdiff_t sy, std::ptrdiff_t sz, uint8_t* marks)
+{
+	const double b_v[3] = {b.x * inv, b.y * inv, b.z * inv};
+	const std::ptrdiff_t stride[3] = {1, sy, sz};
+	std::ptrdiff_t stepOff[3];
+	int32_t remaining[3];
+	double tMax[3], tDelta[3];
+	constexpr double kInf = std::numeric_limits<double>::infinity();
+	for (int k = 0; k < 3; ++k)
+	{
+		const int32_t end = floorToInt(b_v[k]);
+		const double d = b_v[k] - a_v[k];
+		remaining[k] = std::abs(end - aCur[k]);
+		if (remaining[k] == 0 || d == 0.0)
+		{
+			stepOff[k] = 0;
+			remaining[k] = 0;
+			tMax[k] = kInf;
+			tDelta[k] = kInf;
+			continue;
+		}
+		stepOff[k] = d > 0 ? stride[k] : -stride[k];
+		tDelta[k] = std::abs(1.0 / d);
+		const double boundary = d > 0 ? aCur[k] + 1.0 : static_cast<double>(aCur[k]);
+		tMax[k] = (boundary - a_v[k]) / d;
+	}
+	double tx = tMax[0], ty = tMax[1], tz = tMax[2];
+	int32_t rx = remaining[0], ry = remaining[1], rz = remaining[2];
+	const int32_t steps = rx + ry + rz;
+	std::size_t off = aOff;
+	for (int32_t total = steps; total > 0; --total)
+	{
+		uint8_t& m = marks[off];
+		if (!(loadMark(m) & FrameVoxelUpdates::kFree)) orMark(m, FrameVoxelUpdates::kFree);
+		// Same comparisons (and tie-breaking) as traverseSegment.
+		if (tx < ty)
+		{
+			if (tx < tz)
+			{
+				off += stepOff[0];
+				tx = --rx > 0 ? tx + tDelta[0] : kInf;
+			}
+			else
+			{
+				off += stepOff[2];
+				tz = --rz > 0 ? tz + tDelta[2] : kInf;
+			}
+		}
+		else if (ty < tz)
+		{
+			off += stepOff[1];
+			ty = --ry > 0 ? ty + tDelta[1] : kInf;
+		}
+		else
+		{
+			off += stepOff[2];
+			tz = --rz > 0 ? tz + tDelta[2] : kInf;
+		}
+	}
+	return static_cast<std::size_t>(steps) + 1;
+}
 }  // namespace
 
 FrameVoxelUpdates DepthFrameIntegrator::castRays(
@@ -317,22 +520,27 @@ FrameVoxelUpdates DepthFrameIntegrator::castRays(
 
 	if (denseVoxels <= m_opts.maxDenseMarkVoxels)
 	{
-		// Dense mark volume (reused scratch), block-major so each block's 512 marks are
-		// contiguous.
+		// Dense mark volume (reused scratch) over the block-aligned bounding box, x fastest, so
+		// that a DDA step moves the offset by a constant (markFreeLinear).
 		const std::size_t nTotal = static_cast<std::size_t>(denseVoxels);
 		if (m_marks.size() < nTotal) m_marks.resize(nTotal);
 		std::fill(m_marks.begin(), m_marks.begin() + static_cast<std::ptrdiff_t>(nTotal), uint8_t(0));
 		uint8_t* marks = m_marks.data();
-		auto slot = [&](const VoxelIndex& v) -> uint8_t& {
-			const VoxelIndex b = VoxelBlockGrid::blockOf(v);
-			const std::size_t bl = std::size_t(b.x - blo.x) +
-				nbx * (std::size_t(b.y - blo.y) + nby * std::size_t(b.z - blo.z));
-			return marks[bl * VoxelBlock::kVoxels + VoxelBlockGrid::localLinear(v)];
+		const VoxelIndex vlo = VoxelBlockGrid::firstVoxelOf(blo);
+		const std::size_t nx = nbx * VoxelBlock::kSide, ny = nby * VoxelBlock::kSide;
+		auto offsetOf = [&](const VoxelIndex& v) {
+			return std::size_t(v.x - vlo.x) + nx * (std::size_t(v.y - vlo.y) + ny * std::size_t(v.z - vlo.z));
 		};
-		auto markDense = [&](const VoxelIndex& v, uint8_t m) {
-			uint8_t& a = slot(v);
-			// Read first: most voxels near the camera are crossed by many rays.
-			if ((loadMark(a) & m) != m) orMark(a, m);
+		auto slot = [&](const VoxelIndex& v) -> uint8_t& { return marks[offsetOf(v)]; };
+		const double a_v[3] = {origin.x * inv, origin.y * inv, origin.z * inv};
+		const int32_t aCur[3] = {floorToInt(a_v[0]), floorToInt(a_v[1]), floorToInt(a_v[2])};
+		const std::size_t aOff = offsetOf(VoxelIndex{aCur[0], aCur[1], aCur[2]});
+		const std::ptrdiff_t sy = std::ptrdiff_t(nx), sz = std::ptrdiff_t(nx * ny);
+		// One ray on the dense volume: free marks before the end voxel, a hit mark on it.
+		auto castDense = [&](const mrpt::math::TPoint3D& end, const VoxelIndex& endVox, bool hit) {
+			const std::size_t nvis = markFreeLinear(a_v, aCur, aOff, end, inv, sy, sz, marks);
+			if (hit) orMark(slot(endVox), FrameVoxelUpdates::kHit);
+			return nvis;
 		};
 		if (m_opts.discretizeEndpoints)
 		{
@@ -349,15 +557,15 @@ FrameVoxelUpdates DepthFrameIntegrator::castRays(
 						if (!(orMark(a, bit) & bit)) found[t].push_back(ev);
 					}
 			});
-			std::vector<EndVoxel> uniq;
+				std::vector<EndVoxel> uniq;
 			for (auto& f : found) uniq.insert(uniq.end(), f.begin(), f.end());
 			sortUnique(uniq);
 			out.castRays = uniq.size();
-			// Pass 2: one ray per distinct end voxel, to its centre.
+				// Pass 2: one ray per distinct end voxel, to its centre.
 			detail::parallelChunks(uniq.size(), threads, [&](std::size_t b, std::size_t e, unsigned t) {
 				std::size_t vis = 0;
 				for (std::size_t i = b; i < e; ++i)
-					vis += castOne(centre(uniq[i].v), uniq[i].v, uniq[i].hit, markDense);
+					vis += castDense(centre(uniq[i].v), uniq[i].v, uniq[i].hit);
 				visits[t] = vis;
 			}, 2000);
 		}
@@ -368,29 +576,37 @@ FrameVoxelUpdates DepthFrameIntegrator::castRays(
 				std::size_t vis = 0;
 				for (std::size_t i = b; i < e; ++i)
 					if (flags[i])
-						vis += castOne(endOf(i), vox(ends[i].x, ends[i].y, ends[i].z), flags[i] == 2, markDense);
+						vis += castDense(endOf(i), vox(ends[i].x, ends[i].y, ends[i].z), flags[i] == 2);
 				visits[t] = vis;
 			});
 		}
-		// Blocks with any free / hit mark become chunks (the scratch bits 4 and 8 are dropped).
+		// Blocks with any free / hit mark become chunks (the scratch bits 4 and 8 are dropped):
+		// a block's 512 marks are 64 rows of 8 bytes in the volume.
 		constexpr uint64_t kMask = 0x0303030303030303ull;
 		for (std::size_t bz = 0; bz < nbz; ++bz)
 			for (std::size_t by = 0; by < nby; ++by)
 				for (std::size_t bx = 0; bx < nbx; ++bx)
 				{
-					const uint8_t* base = marks + (bx + nbx * (by + nby * bz)) * VoxelBlock::kVoxels;
+					const uint8_t* base = marks + bx * VoxelBlock::kSide +
+						nx * (by * VoxelBlock::kSide + ny * bz * VoxelBlock::kSide);
 					bool any = false;
-					for (int k = 0; k < VoxelBlock::kVoxels && !any; k += 8)
+					for (int r = 0; r < VoxelBlock::kSide * VoxelBlock::kSide && !any; ++r)
 					{
 						uint64_t w;
-						std::memcpy(&w, base + k, 8);
+						std::memcpy(&w, base + (r % VoxelBlock::kSide) * nx + (r / VoxelBlock::kSide) * nx * ny, 8);
 						any = (w & kMask) != 0;
 					}
 					if (!any) continue;
 					out.chunks.emplace_back();
 					FrameVoxelUpdates::Chunk& ch = out.chunks.back();
 					ch.block = {blo.x + int32_t(bx), blo.y + int32_t(by), blo.z + int32_t(bz)};
-					for (int k = 0; k < VoxelBlock::kVoxels; ++k) ch.marks[k] = base[k] & 3;
+					for (int lz = 0; lz < VoxelBlock::kSide; ++lz)
+						for (int ly = 0; ly < VoxelBlock::kSide; ++ly)
+						{
+							const uint8_t* row = base + ly * nx + lz * nx * ny;
+							uint8_t* dst = &ch.marks[VoxelBlock::linear(0, ly, lz)];
+							for (int lx = 0; lx < VoxelBlock::kSide; ++lx) dst[lx] = row[lx] & 3;
+						}
 				}
 	}
 	else

@@ -10,6 +10,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <unordered_map>
+#include <utility>
 
 namespace keygrid
 {
@@ -25,6 +27,12 @@ void MorphingOptions::loadFromConfigFile(
 	const double th = readNumber(c, s, "morphThreads", threads);
 	detail::require(th >= 0 && th == std::floor(th), "morphThreads", th, "an integer >= 0");
 	threads = static_cast<unsigned>(th);
+	const std::string interp = c.read_string(s, "morphInterpolation", "", false);
+	if (interp == "nearest") interpolation = Interpolation::Nearest;
+	else if (interp == "trilinear") interpolation = Interpolation::Trilinear;
+	else if (!interp.empty())
+		throw std::invalid_argument(
+			"[" + s + "] morphInterpolation = '" + interp + "' (expected nearest or trilinear)");
 	validate();
 }
 
@@ -36,6 +44,8 @@ void MorphingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const s
 	detail::writeNumber(c, s, "morphMinWeightDistance", minWeightDistance);
 	detail::writeBool(c, s, "morphKeepVoxelsOutsideCones", keepVoxelsOutsideCones);
 	detail::writeNumber(c, s, "morphThreads", threads);
+	c.write(s, "morphInterpolation",
+		std::string(interpolation == Interpolation::Nearest ? "nearest" : "trilinear"));
 }
 
 void MorphingOptions::validate() const
@@ -210,20 +220,34 @@ VoxelBlockGrid morphAndMerge(const std::vector<const VoxelBlockGrid*>& sources,
 	VoxelBlockGrid out(res);
 	MorphingStats st;
 
-	// 1. Allocate the corrected blocks touched by the forward images of the source blocks.
+	// 1. Allocate the corrected blocks touched by the forward images of the source blocks, and
+	// note which travelled distances each source block's known voxels carry, as a 64-bit mask of
+	// travel bins (step 2 uses it to skip keyframes whose travel window no voxel of the blocks
+	// they would read can pass; conservative, so it changes no result).
 	const double blockEdge = res * VoxelBlock::kSide;
+	double travelMax = 0;
+	for (const auto& kf : keyframes) travelMax = std::max(travelMax, kf.travelled);
+	for (const auto* g : sources)
+		g->forEachKnown([&](const VoxelIndex&, const Voxel& v) { travelMax = std::max(travelMax, double(v.travelled)); });
+	const double binWidth = std::max({opts.travelWindow, travelMax / 64.0, 1e-9});
+	auto travelBin = [&](double t) { return std::clamp(static_cast<int>(std::floor(t / binWidth)), 0, 63); };
+	std::vector<std::unordered_map<VoxelIndex, uint64_t, VoxelIndexHash>> travelBins(sources.size());
 	for (std::size_t s = 0; s < sources.size(); ++s)
 	{
+		travelBins[s].reserve(sources[s]->numBlocks());
 		for (const auto& [bidx, blk] : sources[s]->blocks())
 		{
 			std::vector<const PreparedKeyframe*> used;
+			uint64_t bins = 0;
 			for (const Voxel& v : blk->voxels)
 			{
 				if (!v.isKnown()) continue;
+				bins |= uint64_t(1) << travelBin(v.travelled);
 				++st.sourceVoxels;
 				const PreparedKeyframe* k = lastUpdater(s, v.travelled);
 				if (std::find(used.begin(), used.end(), k) == used.end()) used.push_back(k);
 			}
+			if (!used.empty()) travelBins[s].emplace(bidx, bins);
 			const VoxelIndex first = VoxelBlockGrid::firstVoxelOf(bidx);
 			for (const PreparedKeyframe* k : used)
 			{
@@ -255,7 +279,8 @@ VoxelBlockGrid morphAndMerge(const std::vector<const VoxelBlockGrid*>& sources,
 
 	const unsigned nt = detail::resolveThreads(opts.threads);
 	std::vector<MorphingStats> partial(nt);
-	const double zMin = opts.minWeightDistance, pw = opts.weightExponent;
+	const double zMin = opts.minWeightDistance, pw = opts.weightExponent, invRes = 1.0 / res;
+	const bool trilinear = opts.interpolation == MorphingOptions::Interpolation::Trilinear;
 	detail::parallelChunks(outBlocks.size(), nt, [&](std::size_t b0, std::size_t b1, unsigned t) {
 		MorphingStats& ps = partial[t];
 		// Keyframes whose cone meets the block; `partial` ones need the per-voxel cone test.
@@ -264,11 +289,47 @@ VoxelBlockGrid morphAndMerge(const std::vector<const VoxelBlockGrid*>& sources,
 		{
 			const PreparedKeyframe* k;
 			bool partial;
-			VoxelIndex lastBlock;
-			const VoxelBlock* lastPtr;
+			/** Source blocks read through this keyframe, direct-mapped by the parity of the
+			 * block coordinates: the (up to 8) blocks of one trilinear lookup never collide. */
+			VoxelIndex cacheKey[8];
+			const VoxelBlock* cachePtr[8];
+
+			const VoxelBlock* block(const VoxelIndex& b)
+			{
+				const int slot = (b.x & 1) | ((b.y & 1) << 1) | ((b.z & 1) << 2);
+				if (cacheKey[slot] != b)
+				{
+					cacheKey[slot] = b;
+					cachePtr[slot] = k->grid->findBlock(b);
+				}
+				return cachePtr[slot];
+			}
 		};
 		std::vector<Near> near;
 		const double radius = 0.5 * std::sqrt(3.0) * blockEdge;
+		// Can a lookup through keyframe k from the block centred at bc pass the travel window?
+		// Its voxels' earlier positions lie within `radius` of newToOld(bc) (rigid map), their
+		// trilinear neighbours within one more voxel: any source block there with a known voxel
+		// in a travel bin of [s_k - W, s_k + W] keeps k. Dropping k otherwise changes no result.
+		auto travelWindowReachable = [&](const PreparedKeyframe& k, const mrpt::math::TPoint3D& bc) {
+			const auto c = k.newToOld(bc);
+			const double r = radius + 1.01 * res;
+			const VoxelBlockGrid& g = *k.grid;
+			const VoxelIndex lo = VoxelBlockGrid::blockOf(g.voxelOf({c.x - r, c.y - r, c.z - r}));
+			const VoxelIndex hi = VoxelBlockGrid::blockOf(g.voxelOf({c.x + r, c.y + r, c.z + r}));
+			const auto& bins = travelBins[k.kf->submap];
+			// Bins of [s_k - W, s_k + W] (a voxel passes the window only if its bin is one of them).
+			const int b0 = travelBin(k.kf->travelled - opts.travelWindow), b1 = travelBin(k.kf->travelled + opts.travelWindow);
+			const uint64_t want = (b1 == 63 ? ~uint64_t(0) : (uint64_t(1) << (b1 + 1)) - 1) & ~((uint64_t(1) << b0) - 1);
+			for (int32_t z = lo.z; z <= hi.z; ++z)
+				for (int32_t y = lo.y; y <= hi.y; ++y)
+					for (int32_t x = lo.x; x <= hi.x; ++x)
+					{
+						const auto it = bins.find({x, y, z});
+						if (it != bins.end() && (it->second & want)) return true;
+					}
+			return false;
+		};
 		for (std::size_t bi = b0; bi < b1; ++bi)
 		{
 			const VoxelIndex first = VoxelBlockGrid::firstVoxelOf(outBlocks[bi].first);
@@ -283,8 +344,14 @@ VoxelBlockGrid morphAndMerge(const std::vector<const VoxelBlockGrid*>& sources,
 						k.lo.z <= bhi.z && k.hi.z >= blo.z))
 					continue;
 				const ConeOverlap ov = sphereVsCone(k, bc, radius, opts.viewConeMaxRange);
-				if (ov != ConeOverlap::Outside)
-					near.push_back({&k, ov == ConeOverlap::Partial, VoxelIndex{INT32_MIN, 0, 0}, nullptr});
+				if (ov == ConeOverlap::Outside) continue;
+				if (opts.travelWindow > 0 && !travelWindowReachable(k, bc))
+					continue;  // every lookup through k would fail the travel window
+				{
+					Near nk{&k, ov == ConeOverlap::Partial, {}, {}};
+					for (int c = 0; c < 8; ++c) nk.cacheKey[c] = VoxelIndex{INT32_MIN, 0, 0}, nk.cachePtr[c] = nullptr;
+					near.push_back(nk);
+				}
 			}
 			if (near.empty()) continue;
 			VoxelBlock& blk = *outBlocks[bi].second;
@@ -303,32 +370,67 @@ VoxelBlockGrid morphAndMerge(const std::vector<const VoxelBlockGrid*>& sources,
 							if (nk.partial &&
 								!coneContains(k->worldToCamNew, k->kf->camera, opts.viewConeMaxRange, X))
 								continue;
-							const VoxelIndex sv = k->grid->voxelOf(k->newToOld(X));
-							const VoxelIndex sb = VoxelBlockGrid::blockOf(sv);
-							if (sb != nk.lastBlock)
+							// Earlier position, trilinear over the known voxel centres around it.
+							const auto P = k->newToOld(X);
+							// Positions within 1e-6 voxel of a centre snap to it, so that an identity or
+							// whole-voxel correction reads exactly one voxel (rounding of the composed pose).
+							auto snap = [](double q) {
+								const double r = std::nearbyint(q);
+								return std::abs(q - r) < 1e-6 ? r : q;
+							};
+							const double px = snap(P.x * invRes - 0.5), py = snap(P.y * invRes - 0.5),
+										 pz = snap(P.z * invRes - 0.5);
+							int32_t x0 = floorToInt(px), y0 = floorToInt(py), z0 = floorToInt(pz);
+							double fx = px - x0, fy = py - y0, fz = pz - z0;
+							if (!trilinear)
 							{
-								nk.lastBlock = sb;
-								nk.lastPtr = k->grid->findBlock(sb);
+								// Nearest voxel: the one corner whose weight is 1.
+								const VoxelIndex nv = k->grid->voxelOf(P);
+								x0 = nv.x, y0 = nv.y, z0 = nv.z;
+								fx = fy = fz = 0.0;
 							}
-							if (!nk.lastPtr) continue;
-							const Voxel* src = &nk.lastPtr->voxels[VoxelBlockGrid::localLinear(sv)];
-							if (!src->isKnown()) continue;
-							// Only content placed near keyframe i along the trajectory follows i's
-							// correction (see travelWindow).
-							if (opts.travelWindow > 0 &&
-								std::abs(double(src->travelled) - k->kf->travelled) > opts.travelWindow)
-								continue;
-							const double dz = std::sqrt((X.x - k->centreNew.x) * (X.x - k->centreNew.x) +
+							double cw = 0, cl = 0, cbest = -1;
+							float ctravel = 0;
+							// All 8 corners in one source block (7 times in 8 per axis): one block lookup.
+							constexpr int m = VoxelBlock::kSide - 1;
+							const VoxelBlock* oneBlock = nullptr;
+							const bool sameBlock = (x0 & m) != m && (y0 & m) != m && (z0 & m) != m;
+							if (sameBlock)
+							{
+								oneBlock = nk.block(VoxelBlockGrid::blockOf(VoxelIndex{x0, y0, z0}));
+								if (!oneBlock) continue;
+							}
+							for (int c = 0; c < 8; ++c)
+							{
+								const VoxelIndex sv{x0 + (c & 1), y0 + ((c >> 1) & 1), z0 + ((c >> 2) & 1)};
+								const double t = ((c & 1) ? fx : 1 - fx) * ((c & 2) ? fy : 1 - fy) * ((c & 4) ? fz : 1 - fz);
+								if (t <= 0) continue;
+								const VoxelBlock* sblk = sameBlock ? oneBlock : nk.block(VoxelBlockGrid::blockOf(sv));
+								if (!sblk) continue;
+								const Voxel& src = sblk->voxels[VoxelBlockGrid::localLinear(sv)];
+								if (!src.isKnown()) continue;
+								if (opts.travelWindow > 0 &&
+									std::abs(double(src.travelled) - k->kf->travelled) > opts.travelWindow)
+									continue;
+								cw += t;
+								cl += t * double(src.logOdds);
+								if (t > cbest) cbest = t, ctravel = src.travelled;
+							}
+							if (cw < 0.5) continue;  // the earlier position is mostly unknown
+							const double Li = cl / cw;
+							const double dz2 = (X.x - k->centreNew.x) * (X.x - k->centreNew.x) +
 								(X.y - k->centreNew.y) * (X.y - k->centreNew.y) +
-								(X.z - k->centreNew.z) * (X.z - k->centreNew.z));
-							const double w = std::pow(std::max(dz, zMin), -pw);
+								(X.z - k->centreNew.z) * (X.z - k->centreNew.z);
+							// w = max(z, zMin)^-p; p = 2 (default) without pow / sqrt.
+							const double w = pw == 2.0 ? 1.0 / std::max(dz2, zMin * zMin)
+													   : std::pow(std::max(std::sqrt(dz2), zMin), -pw);
 							sw += w;
-							swl += w * double(src->logOdds);
+							swl += w * Li;
 							++ps.lookups;
 							if (w > bestW)
 							{
 								bestW = w;
-								bestTravel = src->travelled;
+								bestTravel = ctravel;
 							}
 						}
 						if (sw <= 0) continue;

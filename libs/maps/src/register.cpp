@@ -4,6 +4,7 @@
  * load plugins (SceneViewer3D -l, RawLogViewer -l, rawlog-edit -p) know the classes.
  * One registerClass line per class.
  */
+#include <keygrid/maps/CHOCPointsMap.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <mrpt/core/initializer.h>
@@ -11,6 +12,7 @@
 
 MRPT_INITIALIZER(keygrid_maps_registerAllClasses)
 {
+	mrpt::rtti::registerClass(CLASS_ID(keygrid::CHOCPointsMap));
 	mrpt::rtti::registerClass(CLASS_ID(keygrid::CISMOccupancyGrid2D));
 	mrpt::rtti::registerClass(CLASS_ID(keygrid::CSubmappedOccupancyGrid3D));
 }

@@ -1,11 +1,22 @@
 #include <keygrid/sfm/Tracker.h>
 
 #include <algorithm>
+#include <ctime>
 #include <numeric>
 #include <set>
 
 namespace keygrid::sfm
 {
+namespace
+{
+double threadCpuSeconds()
+{
+	timespec ts{};
+	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+	return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+}  // namespace
+
 Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float d)
 {
 	return {(u - K.cx) / K.fx * d, (v - K.cy) / K.fy * d, static_cast<double>(d)};
@@ -13,7 +24,19 @@ Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float 
 
 PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& c) { return {c.fx, c.fy, c.cx, c.cy}; }
 
-Tracker::Tracker(SparseMap& map, const TrackerOptions& opts) : m_map(map), m_opts(opts) {}
+Tracker::Tracker(SparseMap& map, const TrackerOptions& opts) : m_map(map), m_opts(opts)
+{
+	if (opts.hoc.enabled) m_hoc.emplace(opts.hoc);
+}
+
+bool Tracker::hocUsable(LandmarkId id, const Current& cur)
+{
+	if (!m_hoc) return true;
+	const double t0 = threadCpuSeconds();
+	const bool ok = m_hoc->usable(m_map.landmark(id), m_map, translationOf(cur.T_world_cam));
+	m_hocSelectionSeconds += threadCpuSeconds() - t0;
+	return ok;
+}
 
 TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 {
@@ -95,6 +118,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 			out.observedLandmarks.push_back(l);
 			out.observations.push_back(ob);
 		}
+		if (m_hoc) updateHoc(cur, out);
 		if (needKeyFrame(cur))
 		{
 			out.keyframe = createKeyFrame(cur);
@@ -131,6 +155,7 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	kf.T_world_cam = cur.T_world_cam;
 	kf.features = cur.features;
 	kf.depth = cur.frame->depth;
+	kf.colour = (cur.frame->colour.empty() ? cur.frame->grey : cur.frame->colour).clone();
 	const KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;
 	const auto& f = m_map.keyframe(id).features;
 	for (std::size_t i = 0; i < f.size(); i++)
@@ -154,7 +179,7 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	return true;
 }
 
-std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(const Current& cur, bool countVisible)
+std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool forLocalMap)
 {
 	std::set<LandmarkId> already(cur.matches.begin(), cur.matches.end());
 	std::set<LandmarkId> seen;
@@ -171,7 +196,12 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(const Current& cur
 			auto& lm = m_map.landmark(id);
 			ProjectedLandmark p;
 			if (!projectLandmark(lm, T_cam_world, center, m_K, cur.features, m_opts.matcher, p)) continue;
-			if (countVisible) lm.visibleCount++;
+			if (!hocUsable(id, cur))
+			{
+				if (forLocalMap) cur.hocExcluded.push_back(p);
+				continue;
+			}
+			if (forLocalMap) lm.visibleCount++;
 			out.push_back(p);
 		}
 	}
@@ -227,7 +257,7 @@ bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minInliers)
 	for (const auto& [i, j] : pairs)
 	{
 		const LandmarkId lm = kf.landmarks[j];
-		if (lm == kNoLandmark || !m_map.hasLandmark(lm)) continue;
+		if (lm == kNoLandmark || !m_map.hasLandmark(lm) || !hocUsable(lm, cur)) continue;
 		pw.push_back(m_map.landmark(lm).p_world);
 		px.emplace_back(cur.features.undistorted[i].x, cur.features.undistorted[i].y);
 		link.emplace_back(i, lm);
@@ -296,12 +326,35 @@ int Tracker::trackLocalMap(Current& cur, float radius)
 	// Landmarks matched before this stage were in view too.
 	for (LandmarkId l : cur.matches)
 		if (l != kNoLandmark && m_map.hasLandmark(l)) m_map.landmark(l).visibleCount++;
+	cur.matchedBeforeLocalMap = cur.matches;
+	cur.hocExcluded.clear();
 	auto cands = projectLocalLandmarks(cur, true);
 	searchByProjection(cur.features, cands, radius, m_opts.matcher, cur.matches);
+	if (m_hoc) cur.hocVisible = cands;
 	const int inl = refinePose(cur);
 	for (LandmarkId l : cur.matches)
 		if (l != kNoLandmark && m_map.hasLandmark(l)) m_map.landmark(l).foundCount++;
 	return inl;
+}
+
+void Tracker::updateHoc(Current& cur, TrackedFrame& out)
+{
+	// Thread CPU time: the cost of the bookkeeping itself, not of waiting for a busy core.
+	const double t0 = threadCpuSeconds();
+	// Matches of the earlier stages that the final refinement rejected were in view too.
+	const auto T_cam_world = -cur.T_world_cam;
+	const Eigen::Vector3d centre = translationOf(cur.T_world_cam);
+	std::set<LandmarkId> finalMatches(cur.matches.begin(), cur.matches.end());
+	for (LandmarkId id : cur.matchedBeforeLocalMap)
+	{
+		if (id == kNoLandmark || finalMatches.count(id) || !m_map.hasLandmark(id)) continue;
+		ProjectedLandmark p;
+		if (projectLandmark(m_map.landmark(id), T_cam_world, centre, m_K, cur.features, m_opts.matcher, p)) cur.hocVisible.push_back(p);
+	}
+	out.hoc = m_hoc->update(m_map, cur.features, cur.matches, cur.hocVisible, cur.hocExcluded, cur.frame->depth, centre,
+							m_opts.radiusLocalMap, m_opts.matcher);
+	out.hocSeconds = threadCpuSeconds() - t0 + m_hocSelectionSeconds;
+	m_hocSelectionSeconds = 0;
 }
 
 bool Tracker::needKeyFrame(const Current& cur) const
@@ -333,6 +386,7 @@ KeyFrameId Tracker::createKeyFrame(const Current& cur)
 	kf.T_world_cam = cur.T_world_cam;
 	kf.features = cur.features;
 	kf.depth = cur.frame->depth;
+	kf.colour = (cur.frame->colour.empty() ? cur.frame->grey : cur.frame->colour).clone();
 	kf.parent = m_refKf;
 	kf.hasParent = m_map.hasKeyFrame(m_refKf);
 	const KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;

@@ -16,11 +16,15 @@ void MapFeedOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	ism2dInput = c.read_string(s, "ism2d_input", ism2dInput);
 	if (ism2dInput != "sparse" && ism2dInput != "dense")
 		throw std::invalid_argument("[" + s + "] ism2d_input = '" + ism2dInput + "' (expected sparse or dense)");
+	floorKeyframes = c.read_int(s, "floor_keyframes", floorKeyframes);
+	if (floorKeyframes < 1)
+		throw std::invalid_argument("[" + s + "] floor_keyframes = " + std::to_string(floorKeyframes) + " (must be >= 1)");
 }
 
 void MapFeedOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
 	c.write(s, "ism2d_input", ism2dInput, 30, 40, "sparse (map points) | dense (depth image)");
+	c.write(s, "floor_keyframes", floorKeyframes, 30, 40, "sparse 2D grid: first keyframes whose points estimate the floor together");
 }
 
 namespace
@@ -59,6 +63,29 @@ mrpt::obs::CObservation3DRangeScan::Ptr depthObservation(const sfm::KeyFrame& kf
 	return obs;
 }
 }  // namespace
+
+CHOCPointsMap hocPointsFromLandmarks(const sfm::SparseMap& map, const maps::HocOptions& hoc)
+{
+	CHOCPointsMap m(hoc);
+	const auto nb = static_cast<std::size_t>(m.geometry().numBins());
+	std::vector<CHOCPointsMap::Point> pts;
+	pts.reserve(map.numLandmarks());
+	for (const auto& [id, lm] : map.landmarks())
+	{
+		CHOCPointsMap::Point p;
+		p.id = id;
+		p.p = {lm.p_world.x(), lm.p_world.y(), lm.p_world.z()};
+		if (!lm.descriptor.empty())
+		{
+			const cv::Mat d = lm.descriptor.isContinuous() ? lm.descriptor : lm.descriptor.clone();
+			p.descriptor.assign(d.data, d.data + d.total() * d.elemSize());
+		}
+		if (lm.hoc.counts().size() == nb) p.hoc = lm.hoc;
+		pts.push_back(std::move(p));
+	}
+	m.setPoints(std::move(pts));
+	return m;
+}
 
 MetricMaps::MetricMaps(const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed) : m_feed(feed)
 {
@@ -111,15 +138,31 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 						const auto& p = map.landmark(l).p_world;
 						pts.emplace_back(p.x(), p.y(), p.z());
 					}
-				if (!ism->floorKnown() && ism->insertionOptions.estimateFloorFromDepth)
-					ism->estimateFloorFromPoints(pts, kf.T_world_cam);
+				bool rebuild = false;
+				// Until the floor is found, and then for floor_keyframes keyframes in all.
+				constexpr std::size_t kMaxFloorPoints = 200000;
+				if (ism->insertionOptions.estimateFloorFromDepth && (!ism->floorKnown() || m_floorKeyframes < m_feed.floorKeyframes) &&
+					m_floorPoints.size() < kMaxFloorPoints)
+				{
+					if (!m_firstKeyframePose) m_firstKeyframePose = kf.T_world_cam;
+					m_floorPoints.insert(m_floorPoints.end(), pts.begin(), pts.end());
+					m_floorKeyframes++;
+					const bool known = ism->floorKnown();
+					const auto before = ism->floorPose();
+					if (ism->estimateFloorFromPoints(m_floorPoints, *m_firstKeyframePose) && known)
+						rebuild = (ism->floorPose().asTPose() - before.asTPose()).norm() > 1e-9;
+				}
 				ism->insertKeyframePoints(id, kf.T_world_cam, pts);
+				// A better floor: the keyframes inserted so far are integrated again (cheap).
+				if (rebuild) ism->applyTrajectoryCorrection({});
 			}
 		}
 		else if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get()))
 		{
 			if (!kf.depth.empty()) g3->insertDepthFrame(kf.depth, kf.features.camera, kf.T_world_cam, travelled, id);
 		}
+		else if (dynamic_cast<CHOCPointsMap*>(m.get()))
+			continue;  // filled from the frontend's landmarks (syncLandmarks)
 		else if (!kf.depth.empty())
 		{
 			if (!obs) obs = depthObservation(kf);
@@ -137,6 +180,7 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 		std::string name = m->GetRuntimeClass()->className;
 		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
 		{
+			if (!ism->floorKnown()) continue;  // nothing integrated yet: no floor frame
 			std::map<uint64_t, mrpt::poses::CPose3D> np;
 			for (const auto& [id, T] : newPoses)
 				if (ism->keyframes().count(id)) np[id] = T;
@@ -156,6 +200,21 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 	for (const auto& [id, T] : newPoses)
 		if (m_insertedPoses.count(id)) m_insertedPoses[id] = T;
 	return out;
+}
+
+void MetricMaps::syncLandmarks(const sfm::SparseMap& map, const maps::HocOptions& hoc)
+{
+	for (auto& m : m_maps.maps)
+		if (auto* h = dynamic_cast<CHOCPointsMap*>(m.get()))
+		{
+			const auto render = h->renderOptions;
+			const auto ins = h->insertionOptions;
+			const auto lik = h->likelihoodOptions;
+			*h = hocPointsFromLandmarks(map, hoc);
+			h->renderOptions = render;
+			h->insertionOptions = ins;
+			h->likelihoodOptions = lik;
+		}
 }
 
 void MetricMaps::notifyLoopClosure()
@@ -185,6 +244,11 @@ std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const
 			g3->saveOccupiedAsPly(dir + "/map_3d" + suffix + ".ply");
 			files.insert(files.end(), {"map_3d" + suffix + ".bt", "map_3d" + suffix + ".ply"});
 		}
+		else if (const auto* hoc = dynamic_cast<const CHOCPointsMap*>(m.get()))
+		{
+			hoc->saveAsPly(dir + "/hoc_points" + suffix + ".ply");
+			files.push_back("hoc_points" + suffix + ".ply");
+		}
 		else
 		{
 			// MRPT's own representation (e.g. octoMap writes .bt, pointsMap .txt).
@@ -212,6 +276,8 @@ std::string MetricMaps::summaryJson() const
 			o << ", \"cells\": " << ism->sizeX() * ism->sizeY() << ", \"states\": [" << c[0] << ", " << c[1] << ", " << c[2]
 			  << "], \"keyframes\": " << ism->keyframes().size();
 		}
+		else if (const auto* hoc = dynamic_cast<const CHOCPointsMap*>(m.get()))
+			o << ", \"points\": " << hoc->size();
 		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
 			o << ", \"submaps\": " << g3->numSubmaps() << ", \"memory_bytes\": " << g3->memoryBytes()
 			  << ", \"keyframes\": " << g3->keyframes().size();

@@ -14,6 +14,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 		throw std::invalid_argument("[slam] mode = '" + mode + "' (expected sequential or threaded)");
 	features.loadFromConfigFile(c, "features");
 	tracker.loadFromConfigFile(c, "tracker");
+	tracker.hoc.loadFromConfigFile(c, "hoc");
 	mapping.loadFromConfigFile(c, "mapping");
 	refinement.globalBundleAdjustment = c.read_bool("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment);
 	refinement.globalIterations = c.read_int("refinement", "global_iterations", refinement.globalIterations);
@@ -32,6 +33,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	c.write("slam", "camera", camera.empty() ? std::string("auto") : camera, 30, 40, "preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
 	features.saveToConfigFile(c, "features");
 	tracker.saveToConfigFile(c, "tracker");
+	tracker.hoc.saveToConfigFile(c, "hoc");
 	mapping.saveToConfigFile(c, "mapping");
 	c.write("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment, 30, 40, "bundle-adjust everything after the last frame");
 	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "");

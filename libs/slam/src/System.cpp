@@ -38,6 +38,15 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	if (!m_K) m_K = K;
 	sfm::TrackedFrame tf = m_tracker.track(frame, std::move(features));
 	m_timings.add("track", secondsSince(t0));
+	if (m_cfg.tracker.hoc.enabled)
+	{
+		m_timings.add("hoc", tf.hocSeconds);
+		m_stats.landmarksPrunedHoc += tf.hoc.pruned;
+		m_stats.hocIncrements += tf.hoc.incremented;
+		m_stats.hocDecrements += tf.hoc.decremented;
+		m_stats.hocOccluded += tf.hoc.occluded;
+		m_stats.hocRecovered += tf.hoc.recovered;
+	}
 	if (tf.tracked)
 	{
 		if (m_lastTrackedPose) m_travelled += (tf.T_world_cam.translation() - m_lastTrackedPose->translation()).norm();
@@ -52,6 +61,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		{
 			t0 = std::chrono::steady_clock::now();
 			m_maps->insertKeyFrame(m_map, tf.keyframe, m_travelled);
+			m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 			m_timings.add("map_insertion", secondsSince(t0));
 		}
 		if (m_loopCloser && m_map.hasKeyFrame(tf.keyframe))
@@ -81,6 +91,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		m_stats.sumBaObservations += rep.ba.observations;
 		m_stats.sumBaOutliers += rep.ba.outliersRemoved;
 	}
+	tf.mapLandmarks = m_map.numLandmarks();
 	m_stats.frames++;
 	m_stats.sumInliers += tf.inliers;
 	if (tf.tracked) m_stats.tracked++;
@@ -114,6 +125,7 @@ void System::finish()
 			if (f.newKeyFrame && m_map.poseOf(f.keyframe, T)) poses[f.keyframe] = T;
 		}
 		for (const auto& [name, sec] : m_maps->applyCorrection(poses)) m_timings.add("map_correction:" + name, sec);
+		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 	}
 	if (!m_cfg.refinement.refineFrames) return;
 	const auto t1 = std::chrono::steady_clock::now();

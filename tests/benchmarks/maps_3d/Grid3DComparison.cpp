@@ -15,6 +15,7 @@
 #include <keygrid/core/RgbdObservation.h>
 #include <keygrid/core/TumFrameSource.h>
 #include <keygrid/core/TumTrajectory.h>
+#include <keygrid/eval/Alignment.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <mrpt/maps/COccupancyGridMap3D.h>
 #include <mrpt/maps/CSimplePointsMap.h>
@@ -25,6 +26,8 @@
 #include <octomap/OcTree.h>
 
 #include <algorithm>
+#include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -49,8 +52,11 @@ struct Args
 	double conflictTravel = -1;  // < 0: the ConflictOptions default
 	double driftM = 0.2, driftDeg = 6.0;  // synthetic drift at the last frame
 	std::string gtVoxels;  // keygrid-sim occupancy_voxels.txt (optional)
+	std::vector<std::string> scoreBt;  // keygrid-slam output dirs: score DIR/map_3d.bt vs the sim GT
+	std::string simDir;
 	std::string camera;  // camera preset or INI (optional; TUM folders guess it otherwise)
 	bool verbose = false;  // per-keyframe evidence of the drifted run
+	bool profile = false;  // time castFrame / evaluateFrame / apply separately
 };
 
 /** One frame as the three mappers see it. */
@@ -116,13 +122,91 @@ double octreeKnownVolume(const octomap::OcTree& tree)
 	return v;
 }
 
+/** Wall clock and CPU time of the calling thread [s] (CPU time is what a single-threaded
+ * mapper costs even when other processes share the cores). */
+struct Clock
+{
+	double wall0{now()}, cpu0{cpu()};
+	static double now() { return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(); }
+	static double cpu()
+	{
+		timespec ts{};
+		clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+		return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+	}
+	void restart() { wall0 = now(), cpu0 = cpu(); }
+	double wall() const { return now() - wall0; }
+	double cpuTime() const { return cpu() - cpu0; }
+};
+/** Steady-state [ms per frame] over frames 2..N: wall and calling-thread CPU time. */
+struct FrameTime
+{
+	double wallMs{1e300}, cpuMs{1e300};
+	void keepMin(const FrameTime& o) { wallMs = std::min(wallMs, o.wallMs), cpuMs = std::min(cpuMs, o.cpuMs); }
+};
+template <class InsertFrame>
+FrameTime timeFrames(std::size_t n, InsertFrame&& insert)
+{
+	Clock c;
+	double w1 = 0, c1 = 0;
+	for (std::size_t i = 0; i < n; ++i)
+	{
+		insert(i);
+		if (i == 0) w1 = c.wall(), c1 = c.cpuTime();  // the first frame builds caches: excluded
+	}
+	const double k = n > 1 ? 1000.0 / double(n - 1) : 1000.0;
+	if (n <= 1) return {k * w1, k * c1};
+	return {k * (c.wall() - w1), k * (c.cpuTime() - c1)};
+}
+
+/** Timing breakdown of keygrid's integration steps (the three calls insertDepthFrame makes),
+ * steady state (frames 2..N), for 1 thread and all threads. */
+void profileSteps(const std::vector<BenchFrame>& frames, const Args& a)
+{
+	if (frames.size() < 2) return;
+	for (unsigned threads : {1u, 0u})
+	{
+		DepthIntegrationOptions io;
+		io.maxRange = a.maxRange;
+		io.minRange = 0.0;
+		io.threads = threads;
+		DepthFrameIntegrator integ(io);
+		VoxelBlockGrid grid(a.res);
+		ConflictOptions co;
+		double tCast = 0, tEval = 0, tApply = 0, cpuCast = 0;
+		std::size_t castRays = 0, visits = 0, chunks = 0;
+		for (std::size_t i = 0; i < frames.size(); ++i)
+		{
+			Clock t;
+			const auto upd = integ.castFrame(frames[i].depth, frames[i].cam, frames[i].T_world_cam, a.res);
+			const double c = t.wall(), cc = t.cpuTime();
+			t.restart();
+			const auto ev = evaluateFrame(grid, upd, 0.0, co, threads);
+			const double e = t.wall();
+			t.restart();
+			integ.apply(grid, upd, 0.0);
+			const double p = t.wall();
+			(void)ev;
+			if (i == 0) continue;
+			tCast += c, tEval += e, tApply += p, cpuCast += cc;
+			castRays += upd.castRays, visits += upd.voxelVisits, chunks += upd.chunks.size();
+		}
+		const double n = double(frames.size() - 1);
+		std::printf("profile (%s, wall): castFrame %.3f ms (calling thread CPU %.3f ms), evaluateFrame %.3f ms, apply %.3f ms "
+					"per frame; %.0f rays cast, %.0f voxel visits, %.0f chunks per frame\n",
+			threads == 1 ? "1 thread" : "all threads", 1e3 * tCast / n, 1e3 * cpuCast / n, 1e3 * tEval / n, 1e3 * tApply / n,
+			double(castRays) / n, double(visits) / n, double(chunks) / n);
+	}
+}
+
 void runComparison(const std::string& label, const std::vector<BenchFrame>& frames, const Args& a)
 {
 	std::printf("\n=== %s: %zu frame(s), %.0f mm voxels, max range %.1f m, every pixel ===\n",
 		label.c_str(), frames.size(), a.res * 1000, a.maxRange);
 	if (frames.empty()) return;
+	if (a.profile) profileSteps(frames, a);
 
-	// keygrid, all cores and one core.
+	// keygrid, all cores and one core; OctoMap. Each `repeat` times, the fastest run kept.
 	auto runKeygrid = [&](unsigned threads, CSubmappedOccupancyGrid3D& m) {
 		m.setResolution(a.res);
 		m.insertionOptions.integration.maxRange = a.maxRange;
@@ -130,44 +214,34 @@ void runComparison(const std::string& label, const std::vector<BenchFrame>& fram
 		m.insertionOptions.integration.threads = threads;
 		// One consistent trajectory (ground truth): keep a single submap for the comparison.
 		m.insertionOptions.conflict.conflictMinVoxels = 1e12;
-		mrpt::system::CTicTac t;
-		double travelled = 0, first = 0;
-		for (std::size_t i = 0; i < frames.size(); ++i)
-		{
+		double travelled = 0;
+		return timeFrames(frames.size(), [&](std::size_t i) {
 			if (i > 0) travelled += frames[i].T_world_cam.distanceTo(frames[i - 1].T_world_cam);
 			m.insertDepthFrame(frames[i].depth, frames[i].cam, frames[i].T_world_cam, travelled, i);
-			if (i == 0) first = t.Tac();
-		}
-		// Steady state: the first frame also builds the per-camera undistorted ray table.
-		return frames.size() > 1 ? 1000.0 * (t.Tac() - first) / (frames.size() - 1) : 1000.0 * first;
+		});
 	};
-	CSubmappedOccupancyGrid3D kg, kg1;
-	double kgMs = 1e300, kg1Ms = 1e300;
-	for (unsigned r = 0; r < a.repeat; ++r)
-	{
-		CSubmappedOccupancyGrid3D m, m1;
-		kgMs = std::min(kgMs, runKeygrid(0, m));
-		kg1Ms = std::min(kg1Ms, runKeygrid(1, m1));
-		if (r == 0) kg = m;
-	}
-	const VoxelBlockGrid& g = kg.submap(0).grid;
-
-	// OctoMap.
-	octomap::OcTree tree(a.res);
-	double octoMs = 0;
-	{
-		mrpt::system::CTicTac t;
-		double first = 0;
-		for (std::size_t i = 0; i < frames.size(); ++i)
-		{
+	auto runOctomap = [&](octomap::OcTree& tree) {
+		return timeFrames(frames.size(), [&](std::size_t i) {
 			const auto& f = frames[i];
 			tree.insertPointCloud(f.cloud,
 				octomap::point3d(float(f.T_world_cam.x()), float(f.T_world_cam.y()), float(f.T_world_cam.z())),
 				a.maxRange, false, true);
-			if (i == 0) first = t.Tac();
-		}
-		octoMs = frames.size() > 1 ? 1000.0 * (t.Tac() - first) / (frames.size() - 1) : 1000.0 * first;
+		});
+	};
+	CSubmappedOccupancyGrid3D kg;
+	octomap::OcTree tree(a.res);
+	FrameTime kgT, kg1T, octoT;
+	for (unsigned r = 0; r < a.repeat; ++r)
+	{
+		CSubmappedOccupancyGrid3D m, m1;
+		octomap::OcTree t(a.res);
+		kgT.keepMin(runKeygrid(0, m));
+		kg1T.keepMin(runKeygrid(1, m1));
+		octoT.keepMin(runOctomap(t));
+		if (r == 0) kg = m, tree.swapContent(t);
 	}
+	const double kgMs = kgT.wallMs, kg1Ms = kg1T.wallMs, octoMs = octoT.wallMs;
+	const VoxelBlockGrid& g = kg.submap(0).grid;
 
 	// MRPT COccupancyGridMap3D over the bounding box of the cameras +- max range.
 	double mrptMs = -1, mrptBytes = 0;
@@ -207,10 +281,15 @@ void runComparison(const std::string& label, const std::vector<BenchFrame>& fram
 	table.update(frames.front().cam);
 	std::printf("(excluded from the steady state: keygrid's one-off undistorted ray table, %.1f ms; "
 				"OctoMap's point cloud is built outside its timing)\n", 1000.0 * tt.Tac());
-	std::printf("%-44s %10s %10s\n", "integration (steady state, frames 2..N)", "ms/frame", "x keygrid");
-	std::printf("%-44s %10.1f %10.2f\n", "keygrid CSubmappedOccupancyGrid3D (2 threads)", kgMs, 1.0);
-	std::printf("%-44s %10.1f %10.2f\n", "keygrid CSubmappedOccupancyGrid3D (1 thread)", kg1Ms, kg1Ms / kgMs);
-	std::printf("%-44s %10.1f %10.2f\n", "OctoMap 1.9.7 insertPointCloud(discretize)", octoMs, octoMs / kgMs);
+	std::printf("%-44s %10s %10s %12s %12s\n", "integration (steady state, frames 2..N)", "ms/frame", "x keygrid",
+		"CPU ms/frame", "CPU x kg(1t)");
+	std::printf("%-44s %10.2f %10.2f %12s %12s\n", "keygrid CSubmappedOccupancyGrid3D (2 threads)", kgMs, 1.0, "-", "-");
+	std::printf("%-44s %10.2f %10.2f %12.2f %12.2f\n", "keygrid CSubmappedOccupancyGrid3D (1 thread)", kg1Ms, kg1Ms / kgMs,
+		kg1T.cpuMs, 1.0);
+	std::printf("%-44s %10.2f %10.2f %12.2f %12.2f\n", "OctoMap 1.9.7 insertPointCloud(discretize)", octoMs, octoMs / kgMs,
+		octoT.cpuMs, octoT.cpuMs / kg1T.cpuMs);
+	std::printf("OctoMap / keygrid: wall %.2fx (2 threads), %.2fx (1 thread); CPU %.2fx (1 thread)\n", octoMs / kgMs,
+		octoMs / kg1Ms, octoT.cpuMs / kg1T.cpuMs);
 	if (a.mrpt)
 		std::printf("%-44s %10.1f %10.2f\n", "MRPT COccupancyGridMap3D (decimation 1)", mrptMs, mrptMs / kgMs);
 	std::printf("occupied voxels: keygrid %zu, OctoMap %zu, both %zu -> %.2f%% of OctoMap's, %.2f%% "
@@ -299,12 +378,28 @@ void runCorrection(const std::vector<BenchFrame>& frames, const Args& a)
 	const std::size_t gtSubmaps = build(false, true).numSubmaps();
 	TrajectoryCorrection corr;
 	for (std::size_t i = 0; i < n; ++i) corr[i] = {drifted[i], frames[i].T_world_cam};
-	CSubmappedOccupancyGrid3D mapB = mapA, mapC = mapA;
+	CSubmappedOccupancyGrid3D mapB = mapA, mapC = mapA, mapBn = mapA;
+	// Wall time is what the map reports; process CPU time (all threads) is the work done, which
+	// stays comparable when other processes load the machine.
+	auto processCpu = [] {
+		timespec ts{};
+		clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+		return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+	};
+	double c0 = processCpu();
 	const MorphingStats ms = mapB.morphAndMergeSubmaps(corr);
+	const double cpuB = processCpu() - c0;
+	// The same morphing with nearest-voxel lookups (the earlier default), for comparison.
+	mapBn.morphingOptions.interpolation = MorphingOptions::Interpolation::Nearest;
+	c0 = processCpu();
+	const MorphingStats msn = mapBn.morphAndMergeSubmaps(corr);
+	const double cpuBn = processCpu() - c0;
+	c0 = processCpu();
 	const auto rs = mapC.reintegrateAtCorrectedPoses(corr);
+	const double cpuC = processCpu() - c0;
 	const VoxelBlockGrid& ref = mapD.submap(0).grid;
 	const Score sa = score(mapA.fusedGrid(), ref), sb = score(mapB.submap(0).grid, ref),
-				sc = score(mapC.submap(0).grid, ref);
+				sc = score(mapC.submap(0).grid, ref), sbn = score(mapBn.submap(0).grid, ref);
 	std::printf("\n=== trajectory correction on the same %zu frames (drift up to %.2f m / %.1f deg, "
 				"corrected to ground truth) ===\n", n, a.driftM, a.driftDeg);
 	std::printf("submaps: %zu in the drifted run, %zu with ground-truth poses (conflict detection on)\n",
@@ -312,7 +407,13 @@ void runCorrection(const std::vector<BenchFrame>& frames, const Args& a)
 	std::printf("%-40s %9s %9s %9s %10s\n", "occupied voxels vs ground-truth-pose map", "precision", "recall", "F1", "time [ms]");
 	std::printf("%-40s %9.3f %9.3f %9.3f %10s\n", "(a) drifted poses, no correction", sa.precision, sa.recall, sa.f1, "-");
 	std::printf("%-40s %9.3f %9.3f %9.3f %10.1f\n", "(b) grid morphing + merge", sb.precision, sb.recall, sb.f1, 1000 * ms.seconds);
+	std::printf("%-40s %9.3f %9.3f %9.3f %10.1f\n", "(b') morphing, nearest-voxel lookups", sbn.precision, sbn.recall, sbn.f1, 1000 * msn.seconds);
 	std::printf("%-40s %9.3f %9.3f %9.3f %10.1f\n", "(c) re-integration of stored depth", sc.precision, sc.recall, sc.f1, 1000 * rs.seconds);
+	std::printf("process CPU time [s]: (b) %.3f, (b') %.3f, (c) %.3f -> (c)/(b) %.2f, (c)/(b') %.2f; "
+				"%zu corrected voxels evaluated\n",
+		cpuB, cpuBn, cpuC, cpuC / std::max(cpuB, 1e-9), cpuC / std::max(cpuBn, 1e-9), ms.evaluatedVoxels);
+	std::printf("nearest lookups: F1(b')/F1(c) = %.3f, time(c)/time(b') = %.2f\n", sbn.f1 / std::max(sc.f1, 1e-9),
+		rs.seconds / std::max(msn.seconds, 1e-9));
 	std::printf("F1(b)/F1(c) = %.3f, time(c)/time(b) = %.2f; morphing: %zu source voxels, %zu morphed, "
 				"%zu carried, %zu lookups\n",
 		sb.f1 / std::max(sc.f1, 1e-9), rs.seconds / std::max(ms.seconds, 1e-9), ms.sourceVoxels,
@@ -353,15 +454,58 @@ void runCorrection(const std::vector<BenchFrame>& frames, const Args& a)
 		}
 	}
 	const Score ga = score(mapA.fusedGrid(), gt), gb = score(mapB.submap(0).grid, gt),
-				gc = score(mapC.submap(0).grid, gt), gd = score(ref, gt);
+				gc = score(mapC.submap(0).grid, gt), gd = score(ref, gt), gbn = score(mapBn.submap(0).grid, gt);
 	std::printf("occupied voxels vs simulator ground truth (%zu surface voxels observed by (d)):\n",
 		gt.numKnownVoxels());
 	std::printf("%-40s %9.3f %9.3f %9.3f\n", "(a) drifted poses, no correction", ga.precision, ga.recall, ga.f1);
 	std::printf("%-40s %9.3f %9.3f %9.3f\n", "(b) grid morphing + merge", gb.precision, gb.recall, gb.f1);
+	std::printf("%-40s %9.3f %9.3f %9.3f\n", "(b') morphing, nearest-voxel lookups", gbn.precision, gbn.recall, gbn.f1);
 	std::printf("%-40s %9.3f %9.3f %9.3f\n", "(c) re-integration of stored depth", gc.precision, gc.recall, gc.f1);
 	std::printf("%-40s %9.3f %9.3f %9.3f\n", "(d) ground-truth poses", gd.precision, gd.recall, gd.f1);
-	std::printf("F1(b)/F1(c) = %.3f, F1(c)/F1(a) = %.3f\n", gb.f1 / std::max(gc.f1, 1e-9),
-		gc.f1 / std::max(ga.f1, 1e-9));
+	std::printf("F1(b)/F1(c) = %.3f (nearest: %.3f), F1(c)/F1(a) = %.3f\n", gb.f1 / std::max(gc.f1, 1e-9),
+		gbn.f1 / std::max(gc.f1, 1e-9), gc.f1 / std::max(ga.f1, 1e-9));
+	// keygrid-slam's own map_3d.bt (its world = its first camera frame): carried into the sim
+	// world by the Umeyama alignment of its trajectory to the ground truth, voxel centres mapped
+	// to the nearest sim voxel (this resampling alone costs some F1: it is not axis aligned).
+	for (const std::string& dir : a.scoreBt)
+	{
+		octomap::OcTree t(0.1);
+		if (!t.readBinary(dir + "/map_3d.bt")) throw std::runtime_error("cannot read " + dir + "/map_3d.bt");
+		const auto gtTraj = core::readTumTrajectory(a.simDir + "/groundtruth.txt");
+		const auto est = core::readTumTrajectory(dir + "/trajectory.txt");
+		std::vector<Eigen::Vector3d> xs, ys;
+		std::size_t j = 0;
+		for (const auto& e : est)
+		{
+			while (j < gtTraj.size() && gtTraj[j].t < e.t - 1e-3) ++j;
+			if (j < gtTraj.size() && std::abs(gtTraj[j].t - e.t) <= 1e-3)
+			{
+				xs.emplace_back(e.T_world_cam.x(), e.T_world_cam.y(), e.T_world_cam.z());
+				ys.emplace_back(gtTraj[j].T_world_cam.x(), gtTraj[j].T_world_cam.y(), gtTraj[j].T_world_cam.z());
+			}
+		}
+		const auto S = eval::alignPointSets(xs, ys, false);
+		VoxelBlockGrid g(a.res);
+		const double r = t.getResolution();
+		for (auto it = t.begin_leafs(); it != t.end_leafs(); ++it)
+		{
+			if (!t.isNodeOccupied(*it)) continue;
+			const int n = 1 << (16 - int(it.getDepth()));  // voxels per edge of this leaf
+			const auto k = it.getIndexKey();  // key of the leaf's first voxel
+			for (int dz = 0; dz < n; ++dz)
+				for (int dy = 0; dy < n; ++dy)
+					for (int dx = 0; dx < n; ++dx)
+					{
+						const Eigen::Vector3d c((int(k[0]) - 32768 + dx + 0.5) * r, (int(k[1]) - 32768 + dy + 0.5) * r,
+							(int(k[2]) - 32768 + dz + 0.5) * r);
+						const Eigen::Vector3d w = S.apply(c);
+						g.at(g.voxelOf({w.x(), w.y(), w.z()})) = Voxel{1.0f, 0.0f};
+					}
+		}
+		const Score sc = score(g, gt);
+		std::printf("%-40s %9.3f %9.3f %9.3f  (%s/map_3d.bt, %zu occupied voxels)\n", "keygrid-slam map_3d.bt", sc.precision,
+			sc.recall, sc.f1, dir.c_str(), g.numKnownVoxels());
+	}
 }
 
 std::vector<BenchFrame> loadTum(const Args& a)
@@ -449,18 +593,21 @@ int main(int argc, char** argv)
 		else if (k == "--morph-window") a.morphWindow = std::stod(val());
 		else if (k == "--conflict-travel") a.conflictTravel = std::stod(val());
 		else if (k == "--verbose") a.verbose = true;
+		else if (k == "--profile") a.profile = true;
+		else if (k == "--score-slam") a.scoreBt.push_back(val());
 		else if (k == "--drift") a.driftM = std::stod(val()), a.driftDeg = std::stod(val());
 		else if (k == "--sim")
 		{
 			const std::string d = val();
 			a.tum = d + "/tum";
 			a.gtVoxels = d + "/occupancy_voxels.txt";
+			a.simDir = d;
 			a.camera = d + "/tum/camera.ini";
 		}
 		else
 		{
 			std::fprintf(stderr, "usage: %s [--tum DIR] [--rawlog FILE] [--frames N] [--stride K] "
-				"[--res M] [--max-range M] [--repeat R] [--no-mrpt] [--morph-window M] [--conflict-travel M] [--drift M DEG] [--sim DIR] [--verbose]\n", argv[0]);
+				"[--res M] [--max-range M] [--repeat R] [--no-mrpt] [--morph-window M] [--conflict-travel M] [--drift M DEG] [--sim DIR] [--verbose] [--profile]\n", argv[0]);
 			return k == "--help" ? 0 : 1;
 		}
 	}

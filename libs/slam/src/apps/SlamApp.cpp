@@ -5,6 +5,12 @@
 #include <keygrid/core/ProgressBar.h>
 #include <keygrid/eval/TrajectoryErrors.h>
 #include <keygrid/slam/AtomicFile.h>
+#include <keygrid/slam/Interrupt.h>
+#include <keygrid/slam/LivePreview.h>
+#include <keygrid/slam/LiveRun.h>
+#include <keygrid/slam/SceneExport.h>
+#include <keygrid/slam/SimpleMapExport.h>
+#include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/System.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/SlamApp.h>
@@ -13,6 +19,7 @@
 #include <mrpt/system/filesystem.h>
 
 #include <chrono>
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -68,8 +75,15 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		throw std::runtime_error("cannot create output folder '" + o.output + "'");
 	core::FrameSourceOptions so;
 	if (!cfg.camera.empty() && cfg.camera != "auto") so.camera = core::RgbdCamera::FromPresetOrFile(cfg.camera);
-	// Decoding runs ahead on its own thread in both modes; frames keep their order.
-	auto source = std::make_unique<core::PrefetchingFrameSource>(core::openFrameSource(o.input, so), 4);
+	// Files: decoding runs ahead on its own thread in both modes; frames keep their order.
+	// Live: the camera's newest frame only (LiveRun.h).
+	std::unique_ptr<core::PrefetchingFrameSource> source;
+	std::unique_ptr<LiveFrameSource> live;
+	if (o.live)
+		live = openLiveCamera(o.configPath, cfg);
+	else
+		source = std::make_unique<core::PrefetchingFrameSource>(core::openFrameSource(o.input, so), 4);
+	core::FrameSource& input = live ? static_cast<core::FrameSource&>(*live) : *source;
 	std::optional<core::Trajectory> gt;
 	if (!o.groundTruth.empty()) gt = core::readTumTrajectory(o.groundTruth);
 
@@ -80,9 +94,9 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		if (!maps->empty()) sys.attachMaps(std::move(maps));
 	}
 	SlamRunResult res;
-	const std::size_t total = o.maxFrames ? std::min(o.maxFrames, source->sizeHint().value_or(o.maxFrames)) : source->sizeHint().value_or(0);
+	const std::size_t total = o.maxFrames ? std::min(o.maxFrames, input.sizeHint().value_or(o.maxFrames)) : input.sizeHint().value_or(0);
 	core::ProgressBar bar("keygrid-slam", total, !o.quiet);
-	if (!o.quiet) std::cerr << "keygrid-slam: " << source->describe() << ", " << cfg.mode << " mode\n";
+	if (!o.quiet) std::cerr << "keygrid-slam: " << input.describe() << ", " << (live ? "live" : cfg.mode) << " mode\n";
 	const auto tStart = Clock::now();
 	auto report = [&](const sfm::TrackedFrame& tf) {
 		const double el = since(tStart);
@@ -95,10 +109,19 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 
 	try
 	{
-		if (cfg.mode == "sequential")
+		if (live)
+		{
+			LiveLoopOptions lo;
+			lo.preview = o.preview;
+			lo.maxFrames = o.maxFrames;
+			const auto lr = runLiveLoop(sys, *live, lo, report);
+			res.liveGrabbed = lr.grabbed;
+			res.liveDropped = lr.dropped;
+		}
+		else if (cfg.mode == "sequential")
 		{
 			core::Frame f;
-			for (std::size_t n = 0; !limitReached(n); n++)
+			for (std::size_t n = 0; !limitReached(n) && !interruptRequested(); n++)
 			{
 				auto t0 = Clock::now();
 				if (!source->next(f)) break;
@@ -118,7 +141,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			std::thread producer([&] {
 				try
 				{
-					for (std::size_t n = 0; !limitReached(n); n++)
+					for (std::size_t n = 0; !limitReached(n) && !interruptRequested(); n++)
 					{
 						Extracted e;
 						if (!source->next(e.frame)) break;
@@ -135,13 +158,22 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 				}
 				queue.close();
 			});
-			while (auto e = queue.pop())
+			try
 			{
-				sys.timings().add("load", e->loadSeconds);
-				sys.timings().add("extract", e->extractSeconds);
-				const auto t0 = Clock::now();
-				report(sys.processExtracted(e->frame, std::move(e->features)));
-				sys.timings().add("track_and_map", since(t0));
+				while (auto e = queue.pop())
+				{
+					sys.timings().add("load", e->loadSeconds);
+					sys.timings().add("extract", e->extractSeconds);
+					const auto t0 = Clock::now();
+					report(sys.processExtracted(e->frame, std::move(e->features)));
+					sys.timings().add("track_and_map", since(t0));
+				}
+			}
+			catch (...)
+			{
+				queue.close();  // a joinable std::thread must not be destroyed
+				producer.join();
+				throw;
 			}
 			producer.join();
 			if (!producerError.empty()) throw std::runtime_error(producerError);
@@ -153,6 +185,14 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		res.error = e.what();
 	}
 	bar.finish();
+	const std::size_t skipped = live ? live->innerSkipped() : source->innerSkipped();
+	const std::string lastSkip = live ? std::string() : source->innerLastSkipReason();
+	if (skipped)
+		std::cerr << "keygrid-slam: warning: skipped " << skipped << " input entries"
+				  << (lastSkip.empty() ? std::string() : " (last: " + lastSkip + ")") << "\n";
+	res.interrupted = interruptRequested();
+	if (res.interrupted && !o.quiet)
+		std::cerr << "keygrid-slam: interrupted after " << sys.stats().frames << " frames, writing the outputs\n";
 	sys.finish();
 	const double wall = since(tStart);
 
@@ -166,18 +206,34 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	}
 	{
 		std::ostringstream csv;
-		csv << "index,timestamp,tracked,method,matches,inliers,new_keyframe,reference_keyframe\n";
+		csv << "index,timestamp,tracked,method,matches,inliers,new_keyframe,reference_keyframe,landmarks\n";
 		for (const auto& f : sys.frames())
 		{
 			char line[160];
-			std::snprintf(line, sizeof(line), "%zu,%.6f,%d,%s,%d,%d,%d,%lld\n", f.index, f.timestamp, f.tracked ? 1 : 0,
+			std::snprintf(line, sizeof(line), "%zu,%.6f,%d,%s,%d,%d,%d,%lld,%zu\n", f.index, f.timestamp, f.tracked ? 1 : 0,
 						  f.method.c_str(), f.matches, f.inliers, f.newKeyFrame ? 1 : 0,
-						  f.hasReference ? static_cast<long long>(f.reference) : -1LL);
+						  f.hasReference ? static_cast<long long>(f.reference) : -1LL, f.mapLandmarks);
 			csv << line;
 		}
 		writeFileAtomically(o.output + "/frames.csv", csv.str());
 	}
 	writeFileAtomically(o.output + "/keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
+	try
+	{
+		writeKeyframesSimpleMap(sys.map(), o.output + "/keyframes.simplemap");
+	}
+	catch (const std::exception& e)
+	{
+		if (res.error.empty()) res.error = std::string("writing keyframes.simplemap: ") + e.what();
+	}
+	try
+	{
+		writeRunScene(traj, sys.map(), sys.metricMaps() ? &sys.metricMaps()->maps() : nullptr, o.output + "/scene.3Dscene");
+	}
+	catch (const std::exception& e)
+	{
+		if (res.error.empty()) res.error = std::string("writing scene.3Dscene: ") + e.what();
+	}
 
 	if (sys.loopCloser() && sys.loopCloser()->lastPoseGraph())
 	{
@@ -202,6 +258,19 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			if (res.error.empty()) res.error = std::string("writing maps: ") + e.what();
 		}
 	}
+	// The HOC landmarks are written also when no hocPointsMap is configured.
+	const bool hocMapConfigured = sys.metricMaps() && sys.metricMaps()->maps().mapByClass<CHOCPointsMap>();
+	if (cfg.tracker.hoc.enabled && !hocMapConfigured)
+	{
+		try
+		{
+			hocPointsFromLandmarks(sys.map(), cfg.tracker.hoc).saveAsPly(o.output + "/hoc_points.ply");
+		}
+		catch (const std::exception& e)
+		{
+			if (res.error.empty()) res.error = std::string("writing hoc_points.ply: ") + e.what();
+		}
+	}
 	res.frames = sys.stats().frames;
 	res.tracked = sys.stats().tracked;
 	res.fps = res.frames / std::max(wall, 1e-9);
@@ -222,7 +291,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	const auto& st = sys.stats();
 	std::ostringstream js;
 	js << "{\n";
-	js << "  \"input\": \"" << jsonEscape(o.input) << "\",\n";
+	js << "  \"input\": \"" << jsonEscape(live ? live->describe() : o.input) << "\",\n";
 	js << "  \"config\": \"" << jsonEscape(o.configPath) << "\",\n";
 	js << "  \"mode\": \"" << cfg.mode << "\",\n";
 	js << "  \"frames\": " << st.frames << ",\n";
@@ -230,13 +299,19 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "  \"lost\": " << st.lost << ",\n";
 	js << "  \"relocalizations\": " << st.relocalizations << ",\n";
 	js << "  \"pnp_fallbacks\": " << st.pnpFallbacks << ",\n";
-	js << "  \"skipped_input_entries\": " << source->innerSkipped() << ",\n";
+	js << "  \"skipped_input_entries\": " << skipped << ",\n";
+	if (!lastSkip.empty()) js << "  \"last_skip_reason\": \"" << jsonEscape(lastSkip) << "\",\n";
+	js << "  \"interrupted\": " << (res.interrupted ? "true" : "false") << ",\n";
+	if (live) js << "  \"live\": {\"grabbed\": " << res.liveGrabbed << ", \"dropped\": " << res.liveDropped << "},\n";
 	js << "  \"keyframes\": " << sys.map().numKeyFrames() << ",\n";
 	js << "  \"keyframes_created\": " << st.keyframesCreated << ",\n";
 	js << "  \"keyframes_culled\": " << st.keyframesCulled << ",\n";
 	js << "  \"landmarks\": " << sys.map().numLandmarks() << ",\n";
 	js << "  \"landmarks_culled\": " << st.landmarksCulled << ",\n";
 	js << "  \"landmarks_fused\": " << st.landmarksFused << ",\n";
+	if (cfg.tracker.hoc.enabled)
+		js << "  \"hoc\": {\"landmarks_pruned\": " << st.landmarksPrunedHoc << ", \"increments\": " << st.hocIncrements
+		   << ", \"decrements\": " << st.hocDecrements << ", \"occluded\": " << st.hocOccluded << ", \"recovered\": " << st.hocRecovered << "},\n";
 	js << "  \"loop_closures\": [";
 	for (std::size_t i = 0; i < sys.loopClosures().size(); i++)
 	{
@@ -265,6 +340,8 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	{
 		std::snprintf(b, sizeof(b), "%.9g", errs->ate.rmse);
 		js << "  \"ate_rmse_m\": " << b << ",\n";
+		std::snprintf(b, sizeof(b), "%.9g", errs->ateRotDeg.rmse);
+		js << "  \"ate_rot_rmse_deg\": " << b << ",\n";
 		if (errs->rpeTrans)
 		{
 			std::snprintf(b, sizeof(b), "%.9g", errs->rpeTrans->rmse);
@@ -289,15 +366,24 @@ int SlamApp::run(int argc, const char* const* argv)
 			"adjustment. Writes DIR/trajectory.txt (TUM, every frame), DIR/keyframes.txt and\n"
 			"DIR/report.json (frames, tracked, fps, per-stage timings, map sizes, and ATE with --gt).");
 		cl.option("config", "CFG.ini", "configuration (see config/*.ini) (required)")
-			.option("input", "X.rawlog|TUM_DIR", "MRPT rawlog or TUM RGB-D folder (required)")
+			.option("input", "X.rawlog|TUM_DIR", "MRPT rawlog or TUM RGB-D folder (required unless --live)")
 			.option("output", "DIR", "output folder, created if missing (required)")
 			.option("gt", "GT.txt", "ground-truth trajectory (TUM) to report ATE against")
 			.option("mode", "sequential|threaded", "override [slam] mode")
 			.option("camera", "PRESET|FILE.ini", "override [slam] camera (TUM folders)")
 			.option("max-frames", "N", "stop after N frames", false, "0 (all)")
 			.flag("quiet", "no progress output")
-			.flag("dump-config", "print the full effective configuration (defaults, or --config merged over them) and exit");
+			.flag("live", "grab from the OpenNI2 camera (Kinect/Xtion) of the config's [live] section in real time; Ctrl-C ends the run")
+			.flag("preview", "with --live: show the image and tracked keypoints (default when $DISPLAY is set)")
+			.flag("no-preview", "with --live: no preview window")
+			.flag("dump-config", "print the full effective configuration (defaults, or --config merged over them) and exit")
+			.flag("ini-reference", "print the INI reference (markdown: every section and map plugin, key | default | description) and exit");
 		if (!cl.parse(argc, argv)) return 0;
+		if (cl.flagSet("ini-reference"))
+		{
+			std::cout << iniReferenceMarkdown();
+			return 0;
+		}
 		if (cl.flagSet("dump-config"))
 		{
 			const SlamConfig c = cl.has("config") ? SlamConfig::FromFile(cl.get("config")) : SlamConfig();
@@ -306,8 +392,13 @@ int SlamApp::run(int argc, const char* const* argv)
 			std::cout << "# keygrid-slam effective configuration\n" << mem.getContent();
 			return 0;
 		}
+		const bool live = cl.flagSet("live");
 		for (const char* req : {"config", "input", "output"})
-			if (!cl.has(req)) throw core::CommandLineError(std::string("missing --") + req);
+			if (!cl.has(req) && !(live && std::string(req) == "input"))
+				throw core::CommandLineError(std::string("missing --") + req);
+		if (live && cl.has("input")) throw core::CommandLineError("--live and --input exclude each other");
+		if (cl.flagSet("preview") && cl.flagSet("no-preview"))
+			throw core::CommandLineError("--preview and --no-preview exclude each other");
 		SlamRunOptions o;
 		o.configPath = cl.get("config");
 		o.input = cl.get("input");
@@ -322,6 +413,10 @@ int SlamApp::run(int argc, const char* const* argv)
 			o.maxFrames = static_cast<std::size_t>(n);
 		}
 		o.quiet = cl.flagSet("quiet");
+		o.live = live;
+		o.preview = live && !cl.flagSet("no-preview") && (cl.flagSet("preview") || LivePreview::displayAvailable());
+		// Ctrl-C / SIGTERM end the frame loop; the outputs are still written (Interrupt.h).
+		installInterruptHandlers();
 		const auto r = runSlam(o);
 		std::printf("frames %zu, tracked %zu, %.1f fps", r.frames, r.tracked, r.fps);
 		if (r.ateRmse) std::printf(", ATE rmse %.4f m", *r.ateRmse);
@@ -331,6 +426,8 @@ int SlamApp::run(int argc, const char* const* argv)
 			std::fprintf(stderr, "keygrid-slam: error: %s (outputs of the %zu frames before it were written)\n", r.error.c_str(), r.frames);
 			return 1;
 		}
+		// Shell convention for a run ended by a signal (130 = Ctrl-C), though it finished cleanly.
+		if (r.interrupted) return 128 + (interruptSignal() ? interruptSignal() : SIGINT);
 		return 0;
 	});
 }

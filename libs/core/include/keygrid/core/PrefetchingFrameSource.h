@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <memory>
+#include <mutex>
 #include <thread>
 
 namespace keygrid::core
@@ -30,6 +31,12 @@ class PrefetchingFrameSource : public FrameSource
 	double lastLoadSeconds() const { return m_lastLoad; }
 	/** Skips seen by the inner source (valid once the stream ended). */
 	std::size_t innerSkipped() const { return m_innerSkipped.load(); }
+	/** Why the inner source skipped its latest skipped entry ("" if none). */
+	std::string innerLastSkipReason() const
+	{
+		std::lock_guard<std::mutex> lk(m_skipMutex);
+		return m_innerLastSkip;
+	}
 
    private:
 	struct Item
@@ -45,6 +52,8 @@ class PrefetchingFrameSource : public FrameSource
 	std::thread m_worker;
 	double m_lastLoad{0};
 	std::atomic<std::size_t> m_innerSkipped{0};
+	mutable std::mutex m_skipMutex;
+	std::string m_innerLastSkip;  //!< guarded by m_skipMutex
 };
 
 }  // namespace keygrid::core

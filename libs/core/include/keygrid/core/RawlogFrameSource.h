@@ -31,6 +31,7 @@ class RawlogFrameSource : public FrameSource
 	std::unique_ptr<Impl> m_impl;
 	std::string m_path;
 	std::size_t m_fileSize{0};
+	bool m_compressed{false};  //!< gzip file (positions are then in uncompressed bytes)
 	std::size_t m_nextIndex{0};
 };
 

@@ -36,6 +36,10 @@ struct TrajectoryErrors
 	std::size_t gtPoses{0}, estPoses{0}, matched{0};
 	Similarity3 alignment;  //!< maps estimated positions into the ground-truth frame
 	ErrorStats ate;         //!< absolute trajectory error, translation [m]
+	/** Absolute orientation error [deg]: angle(R_gt_k^T R_a R_est_k), with R_a the rotation
+	 * closest to sum_k R_gt_k R_est_k^T (chordal mean; unlike the position alignment it is
+	 * defined for a camera that does not move). */
+	ErrorStats ateRotDeg;
 	/** RPE over pose pairs rpeDelta apart, translation [m/s] and rotation [deg/s]; empty when the
 	 * matched trajectory is shorter than rpeDelta. */
 	std::optional<ErrorStats> rpeTrans, rpeRotDeg;

@@ -10,7 +10,8 @@
  *
  *     L(X^) = sum_i w_i L_i / sum_i w_i,   w_i = 1 / max(z_i, zMin)^p,
  *
- * over the cameras whose submap knows X_i, with z_i = |X^ - C^_i| the distance from X^ to the
+ * over the cameras whose submap knows X_i (L_i read with trilinear interpolation by default,
+ * see MorphingOptions::interpolation), with z_i = |X^ - C^_i| the distance from X^ to the
  * corrected camera centre. Choice of w: Kinect-type depth noise grows with z^2 (Khoshelham &
  * Elberink 2012), so near views carry sharper evidence; p = 2 (default) weights by inverse
  * standard deviation, p = 4 would be inverse variance. zMin keeps very near voxels from dominating.
@@ -75,6 +76,18 @@ struct MorphingOptions
 	bool keepVoxelsOutsideCones{true};
 	/** Worker threads, 0 = all (Default: 0) */
 	unsigned threads{0};
+	/** How L_i is read at the earlier position X_i: `nearest` voxel, or `trilinear`
+	 * interpolation over the 8 surrounding voxel centres (unknown ones, and those outside the
+	 * travel window, left out and the weights renormalised; no value when less than half of the
+	 * weight is known). Trilinear avoids the aliasing of nearest lookups on one-voxel-thick
+	 * surfaces whose earlier position falls near a voxel boundary, where the nearest voxel is
+	 * the free one in front of the surface half of the time (INI morphInterpolation;
+	 * Default: trilinear) */
+	enum class Interpolation : uint8_t
+	{
+		Nearest = 0,
+		Trilinear = 1
+	} interpolation{Interpolation::Trilinear};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;

@@ -5,6 +5,7 @@
  * live in their own classes. Ids are monotonic, containers ordered, so iteration (and every
  * result built from it) is deterministic.
  */
+#include <keygrid/maps/HocHistogram.h>
 #include <keygrid/sfm/FrameFeatures.h>
 #include <mrpt/poses/CPose3D.h>
 
@@ -35,6 +36,8 @@ struct Landmark
 	KeyFrameId firstKeyFrame{0};
 	/** Frames where it was predicted in view / actually matched (for culling). */
 	int visibleCount{1}, foundCount{1};
+	/** Histogram of Oriented Cameras (used when [hoc] enabled; see HocFrontend.h). */
+	maps::HocHistogram hoc;
 
 	double foundRatio() const { return static_cast<double>(foundCount) / std::max(1, visibleCount); }
 };
@@ -50,6 +53,9 @@ struct KeyFrame
 	std::vector<LandmarkId> landmarks;
 	/** Depth image [m] (kept for the dense maps; shares the frame's buffer). */
 	cv::Mat depth;
+	/** Image of the keyframe for the exported observations: the frame's colour image (BGR,
+	 * CV_8UC3) or, when the source has none, its grey image (a copy). */
+	cv::Mat colour;
 	/** Covisibility: other keyframe -> number of shared landmarks (>= threshold). */
 	std::map<KeyFrameId, int> covisibility;
 	/** Keyframe that was the reference when this one was created (spanning tree parent). */

@@ -6,6 +6,7 @@
  * is the LocalMapper's job.
  */
 #include <keygrid/core/Frame.h>
+#include <keygrid/sfm/HocFrontend.h>
 #include <keygrid/sfm/SparseMap.h>
 #include <keygrid/sfm/TrackerOptions.h>
 
@@ -42,6 +43,11 @@ struct TrackedFrame
 	 * when the pose is re-estimated against a refined map). */
 	std::vector<LandmarkId> observedLandmarks;
 	std::vector<PoseObservation> observations;
+	/** HOC bookkeeping of this frame (zero when [hoc] is disabled). */
+	HocUpdateStats hoc;
+	double hocSeconds{0};  //!< thread CPU time of HOC selection and update [s]
+	/** Landmarks in the map after this frame (filled by the application). */
+	std::size_t mapLandmarks{0};
 };
 
 class Tracker
@@ -69,6 +75,10 @@ class Tracker
 		std::vector<LandmarkId> matches;
 		mrpt::poses::CPose3D T_world_cam;
 		int inliers{0};
+		/** HOC: local-map landmarks projected for the final search, those the selection
+		 * excluded, and those matched before it (see HocFrontend::update). */
+		std::vector<ProjectedLandmark> hocVisible, hocExcluded;
+		std::vector<LandmarkId> matchedBeforeLocalMap;
 	};
 
 	bool initialize(Current& cur, TrackedFrame& out);
@@ -80,7 +90,14 @@ class Tracker
 	/** Refines cur.T_world_cam from cur.matches; drops outlier matches; returns inliers. */
 	int refinePose(Current& cur);
 	void updateLocalKeyFrames(const Current& cur);
-	std::vector<ProjectedLandmark> projectLocalLandmarks(const Current& cur, bool countVisible);
+	/** Local-map landmarks in view of cur's pose, not yet matched and (with HOC) selected for
+	 * this camera; with `forLocalMap` they are counted as visible and the HOC lists of cur are
+	 * filled. */
+	std::vector<ProjectedLandmark> projectLocalLandmarks(Current& cur, bool forLocalMap);
+	/** HOC selection of one landmark for cur's camera (always true without HOC). */
+	bool hocUsable(LandmarkId id, const Current& cur);
+	/** HOC update and pruning after the pose of cur is final. */
+	void updateHoc(Current& cur, TrackedFrame& out);
 	bool needKeyFrame(const Current& cur) const;
 	KeyFrameId createKeyFrame(const Current& cur);
 
@@ -95,6 +112,8 @@ class Tracker
 	std::vector<KeyFrameId> m_localKfs;
 	std::vector<LandmarkId> m_lastInliers;
 	int m_framesLost{0};
+	std::optional<HocFrontend> m_hoc;
+	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
 };
 
 /** Back-projects an undistorted pixel with depth into the camera frame. */

@@ -2,6 +2,7 @@
 /** \file TrackerOptions.h
  * Parameters of frame tracking and keyframe selection.
  */
+#include <keygrid/maps/HocHistogram.h>
 #include <keygrid/sfm/Matcher.h>
 #include <keygrid/sfm/PnpSolver.h>
 #include <keygrid/sfm/PoseOptimizer.h>
@@ -52,6 +53,9 @@ struct TrackerOptions
 	MatcherOptions matcher;
 	PoseOptimizerOptions pose;
 	PnpOptions pnp;
+	/** Histograms of Oriented Cameras: point selection and pruning ([hoc] section, loaded by
+	 * the application; see HocFrontend.h). */
+	maps::HocOptions hoc;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;

@@ -10,10 +10,12 @@
  * keyframe as a CObservation3DRangeScan at its pose.
  */
 #include <keygrid/core/RgbdCamera.h>
+#include <keygrid/maps/CHOCPointsMap.h>
 #include <keygrid/sfm/SparseMap.h>
 #include <mrpt/maps/CMultiMetricMap.h>
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,10 +27,18 @@ struct MapFeedOptions
 	/** Input of the 2D ISM grid: "sparse" (the keyframe's map points, as in the paper) or
 	 * "dense" (its depth image) (Default: sparse) */
 	std::string ism2dInput{"sparse"};
+	/** Sparse 2D grid with estimateFloorFromDepth: the floor plane is re-estimated from the
+	 * map points of all keyframes so far (the floor is often out of view at the first one)
+	 * until it is found and at least this many keyframes contributed; the grid is rebuilt
+	 * when the floor changes (Default: 10) */
+	int floorKeyframes{10};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 };
+
+/** The frontend's landmarks as a CHOCPointsMap (histograms as the frontend kept them). */
+CHOCPointsMap hocPointsFromLandmarks(const sfm::SparseMap& map, const maps::HocOptions& hoc);
 
 class MetricMaps
 {
@@ -53,6 +63,11 @@ class MetricMaps
 	 * Returns seconds spent per map name. */
 	std::map<std::string, double> applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses);
 
+	/** Copies the frontend's landmarks (positions, descriptors, histograms) into every
+	 * hocPointsMap; its descriptor options become `hoc` (the frontend's [hoc] section), so the
+	 * histograms keep their meaning. Called at every keyframe and after the final refinement. */
+	void syncLandmarks(const sfm::SparseMap& map, const maps::HocOptions& hoc);
+
 	/** Tells the maps the camera is back in mapped space (3D grid: localization mode). */
 	void notifyLoopClosure();
 
@@ -66,6 +81,11 @@ class MetricMaps
 	mrpt::maps::CMultiMetricMap m_maps;
 	MapFeedOptions m_feed;
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> m_insertedPoses;
+	/** Floor estimate of the sparse 2D grid: points of the first keyframes (world frame), how
+	 * many keyframes they came from, and the first keyframe's pose (its "down" is the hint). */
+	std::vector<mrpt::math::TPoint3D> m_floorPoints;
+	int m_floorKeyframes{0};
+	std::optional<mrpt::poses::CPose3D> m_firstKeyframePose;
 };
 
 }  // namespace keygrid::slam

@@ -16,6 +16,10 @@ struct SlamRunOptions
 	std::optional<std::string> modeOverride, cameraOverride;
 	std::size_t maxFrames{0};  //!< 0 = all
 	bool quiet{false};
+	/** Grab from the OpenNI2 camera of the config's [live] section instead of `input` */
+	bool live{false};
+	/** With live: show the image with tracked keypoints in a window */
+	bool preview{false};
 };
 
 /** What a run produced (also written to report.json). */
@@ -25,6 +29,9 @@ struct SlamRunResult
 	double fps{0};
 	std::optional<double> ateRmse;
 	std::string error;  //!< non-empty when the input failed part-way (outputs still written)
+	/** The frame loop was stopped by interruptRequested() (Ctrl-C / SIGTERM) */
+	bool interrupted{false};
+	std::size_t liveGrabbed{0}, liveDropped{0};  //!< live runs: camera frames, and those skipped
 };
 
 /** Runs one sequence end to end; throws on bad configuration or unopenable input. */

@@ -1,0 +1,387 @@
+/** \file BatchApp.cpp
+ * keygrid-batch: prepares the configuration copies, generates the synthetic datasets with
+ * keygrid-sim, runs keygrid-slam on every (dataset, config, repeat) as child processes and
+ * writes the results tables (see BatchApp.h).
+ */
+#include <keygrid/core/CommandLine.h>
+#include <keygrid/slam/AtomicFile.h>
+#include <keygrid/slam/MetricMaps.h>
+#include <keygrid/slam/SlamConfig.h>
+#include <keygrid/slam/apps/AppRunner.h>
+#include <keygrid/slam/apps/BatchApp.h>
+#include <keygrid/slam/apps/BatchProcess.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/vector_loadsave.h>
+
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iostream>
+#include <sstream>
+#include <thread>
+
+namespace keygrid::slam
+{
+namespace
+{
+namespace fs = std::filesystem;
+
+std::string selfDir()
+{
+	std::error_code ec;
+	const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+	return ec ? std::string(".") : exe.parent_path().string();
+}
+
+std::string readText(const std::string& path)
+{
+	std::ifstream f(path);
+	std::stringstream ss;
+	ss << f.rdbuf();
+	return ss.str();
+}
+
+/** The reason a tool printed ("<tool>: error: <reason>"), else its last non-empty line. */
+std::string reasonFromLog(const std::string& logPath)
+{
+	std::istringstream in(readText(logPath));
+	std::string lastError, last;
+	for (std::string l; std::getline(in, l);)
+	{
+		if (!l.empty() && l.back() == '\r') l.pop_back();
+		if (l.find_first_not_of(" \t") == std::string::npos) continue;
+		// Progress bars redraw with '\r': keep the text after the last one.
+		if (const auto cr = l.rfind('\r'); cr != std::string::npos) l = l.substr(cr + 1);
+		last = l;
+		if (const auto e = l.find("error: "); e != std::string::npos) lastError = l.substr(e + 7);
+	}
+	return lastError.empty() ? last : lastError;
+}
+
+std::string utcNow()
+{
+	const std::time_t t = std::time(nullptr);
+	std::tm tm{};
+	gmtime_r(&t, &tm);
+	char b[64];
+	std::strftime(b, sizeof(b), "%Y-%m-%d %H:%M UTC", &tm);
+	return b;
+}
+
+/** "AMD EPYC 7B13 (2 cores), 24 GB, Debian GNU/Linux 12 (bookworm)" */
+std::string machineDescription()
+{
+	auto field = [](const std::string& file, const std::string& key) {
+		std::istringstream in(readText(file));
+		for (std::string l; std::getline(in, l);)
+			if (l.rfind(key, 0) == 0)
+			{
+				std::string v = l.substr(l.find_first_of(":=", key.size()) + 1);
+				v.erase(0, v.find_first_not_of(" \t\""));
+				while (!v.empty() && (v.back() == '"' || v.back() == ' ')) v.pop_back();
+				return v;
+			}
+		return std::string();
+	};
+	std::ostringstream o;
+	const std::string cpu = field("/proc/cpuinfo", "model name");
+	o << (cpu.empty() ? "unknown CPU" : cpu) << " (" << std::thread::hardware_concurrency() << " cores)";
+	const std::string mem = field("/proc/meminfo", "MemTotal");
+	if (!mem.empty()) o << ", " << static_cast<long>(std::stod(mem) / 1048576.0 + 0.5) << " GB";
+	const std::string os = field("/etc/os-release", "PRETTY_NAME");
+	if (!os.empty()) o << ", " << os;
+	// Timings depend on what else runs: the 1-minute load average when the batch started.
+	std::istringstream load(readText("/proc/loadavg"));
+	double l1 = -1;
+	if (load >> l1) o << ", load average " << l1 << " at the start";
+	return o.str();
+}
+
+/** The configuration file with its overrides, checked: throws naming the config and the key. */
+std::string preparedConfig(const ConfigSpec& c)
+{
+	const std::string where = "[config." + c.name + "]";
+	const std::string text = mrpt::io::file_get_contents(c.file);
+	std::string applied = text;
+	if (!c.overrides.empty())
+	{
+		checkOverrideKeys(text, c.overrides, where + " set");
+		applied = applyOverrides(text, c.overrides);
+	}
+	try
+	{
+		mrpt::config::CConfigFileMemory mem(applied);
+		SlamConfig cfg;
+		cfg.loadFromConfigFile(mem);
+		MetricMaps maps(mem, cfg.maps);  // every map the INI asks for must exist
+	}
+	catch (const std::exception& e)
+	{
+		throw std::invalid_argument(where + " (" + c.file + (c.overrides.empty() ? "" : " with set") + "): " + e.what());
+	}
+	std::string header = "# keygrid-batch: " + c.file;
+	for (const auto& o : c.overrides) header += (&o == &c.overrides.front() ? " with " : "; ") + o.section + "." + o.key + "=" + o.value;
+	return header + "\n" + applied;
+}
+
+struct PreparedDataset
+{
+	std::string input, gt, error;
+};
+
+std::string fmtCentimetres(double metres)
+{
+	char b[32];
+	std::snprintf(b, sizeof(b), "%.2f cm", 100.0 * metres);
+	return b;
+}
+
+std::string fmtSeconds(double s)
+{
+	char b[32];
+	std::snprintf(b, sizeof(b), "%.1f s", s);
+	return b;
+}
+}  // namespace
+
+std::vector<RunMetrics> runBatch(const ExperimentSpec& spec, const BatchRunOptions& opts)
+{
+	const std::string bin = opts.binDir.empty() ? selfDir() : opts.binDir;
+	const std::string slamExe = bin + "/keygrid-slam", simExe = bin + "/keygrid-sim";
+	const fs::path out(spec.batch.output);
+	const int jobs = spec.batch.jobs, repeats = spec.batch.repeats;
+	const std::string started = utcNow(), machine = machineDescription();
+
+	// 1. Configuration copies (validated before anything runs).
+	std::vector<std::string> configPaths;
+	for (const auto& c : spec.configs)
+	{
+		const std::string text = preparedConfig(c);
+		configPaths.push_back((out / "_configs" / (c.name + ".ini")).string());
+		if (!opts.dryRun)
+		{
+			fs::create_directories(out / "_configs");
+			writeFileAtomically(configPaths.back(), text);
+		}
+	}
+
+	// 2. Datasets: recorded ones as given, synthetic ones generated (or reused if generated by
+	//    the same command from the same scene text).
+	std::vector<PreparedDataset> data(spec.datasets.size());
+	std::vector<ProcessJob> genJobs;
+	std::vector<std::size_t> genOf;
+	std::vector<std::string> genStamps;
+	for (std::size_t i = 0; i < spec.datasets.size(); i++)
+	{
+		const DatasetSpec& d = spec.datasets[i];
+		if (!d.generated())
+		{
+			data[i].input = d.input;
+			data[i].gt = d.gt;
+			if (data[i].gt.empty() && fs::is_regular_file(fs::path(d.input) / "groundtruth.txt"))
+				data[i].gt = (fs::path(d.input) / "groundtruth.txt").string();
+			continue;
+		}
+		const fs::path dir = out / "_datasets" / d.name;
+		data[i].input = (dir / "tum").string();
+		data[i].gt = (dir / "groundtruth.txt").string();
+		ProcessJob job;
+		job.argv = {simExe, "--scene", d.scene, "--output", dir.string(), "--quiet"};
+		if (d.seed) job.argv.insert(job.argv.end(), {"--seed", std::to_string(*d.seed)});
+		if (d.frames) job.argv.insert(job.argv.end(), {"--frames", std::to_string(*d.frames)});
+		job.logPath = (dir / "keygrid-sim.log").string();
+		const std::string stamp = commandText(job.argv) + "\nscene text hash " +
+								  std::to_string(std::hash<std::string>{}(mrpt::io::file_get_contents(d.scene))) + "\n";
+		if (opts.dryRun)
+		{
+			std::cout << commandText(job.argv) << "\n";
+			continue;
+		}
+		if (readText((dir / "generated-by.txt").string()) == stamp && fs::is_regular_file(data[i].gt))
+		{
+			std::cerr << "keygrid-batch: dataset " << d.name << ": reusing " << dir.string() << "\n";
+			continue;
+		}
+		fs::create_directories(dir);
+		fs::remove(dir / "generated-by.txt");
+		genJobs.push_back(job);
+		genOf.push_back(i);
+		genStamps.push_back(stamp);
+	}
+	if (!genJobs.empty())
+	{
+		std::cerr << "keygrid-batch: generating " << genJobs.size() << " dataset(s) with keygrid-sim\n";
+		runProcesses(genJobs, jobs, spec.batch.timeoutSeconds, [&](std::size_t j, const ProcessOutcome& o) {
+			const std::size_t i = genOf[j];
+			if (o.succeeded())
+				writeFileAtomically((out / "_datasets" / spec.datasets[i].name / "generated-by.txt").string(), genStamps[j]);
+			else
+			{
+				const std::string why = o.launchError.empty() && !o.timedOut ? reasonFromLog(genJobs[j].logPath) : "";
+				data[i].error = "generating the dataset failed: " + (why.empty() ? o.describe() : why);
+			}
+			std::cerr << "keygrid-batch: dataset " << spec.datasets[i].name << " "
+					  << (o.succeeded() ? "generated" : "FAILED: " + data[i].error) << " (" << fmtSeconds(o.seconds) << ")\n";
+		});
+	}
+
+	// 3. The run matrix, dataset-major.
+	std::vector<RunMetrics> runs;
+	std::vector<ProcessJob> runJobs;
+	std::vector<std::size_t> runOf;  // runJobs[j] -> runs[runOf[j]]
+	for (std::size_t di = 0; di < spec.datasets.size(); di++)
+		for (std::size_t ci = 0; ci < spec.configs.size(); ci++)
+			for (int r = 1; r <= repeats; r++)
+			{
+				RunMetrics m;
+				m.dataset = spec.datasets[di].name;
+				m.config = spec.configs[ci].name;
+				m.repeat = r;
+				fs::path dir = out / m.dataset / m.config;
+				if (repeats > 1) dir /= "r" + std::to_string(r);
+				m.runDir = dir.string();
+				m.error = data[di].error;
+				runs.push_back(m);
+				if (!m.error.empty()) continue;
+				ProcessJob job;
+				job.argv = {slamExe, "--config", configPaths[ci], "--input", data[di].input, "--output", m.runDir, "--quiet"};
+				if (!data[di].gt.empty()) job.argv.insert(job.argv.end(), {"--gt", data[di].gt});
+				if (spec.datasets[di].maxFrames > 0)
+					job.argv.insert(job.argv.end(), {"--max-frames", std::to_string(spec.datasets[di].maxFrames)});
+				job.logPath = (dir / "keygrid-slam.log").string();
+				if (opts.dryRun)
+				{
+					std::cout << commandText(job.argv) << "\n";
+					continue;
+				}
+				fs::create_directories(dir);
+				fs::remove(dir / "report.json");  // never read a previous batch's report
+				runJobs.push_back(job);
+				runOf.push_back(runs.size() - 1);
+			}
+	if (opts.dryRun) return {};
+
+	const std::size_t total = runs.size();
+	std::size_t done = total - runJobs.size();
+	std::cerr << "keygrid-batch: " << runJobs.size() << " runs (" << spec.datasets.size() << " datasets x "
+			  << spec.configs.size() << " configs x " << repeats << " repeats), " << jobs << " at a time, outputs in "
+			  << out.string() << "\n";
+	runProcesses(runJobs, jobs, spec.batch.timeoutSeconds, [&](std::size_t j, const ProcessOutcome& o) {
+		RunMetrics& m = runs[runOf[j]];
+		const std::string report = m.runDir + "/report.json";
+		try
+		{
+			RunMetrics rep = readRunReport(report);
+			rep.dataset = m.dataset;
+			rep.config = m.config;
+			rep.repeat = m.repeat;
+			rep.runDir = m.runDir;
+			m = rep;
+		}
+		catch (const std::exception& e)
+		{
+			if (o.succeeded()) m.error = e.what();
+		}
+		m.seconds = o.seconds;
+		if (!o.succeeded() && m.error.empty())
+		{
+			const std::string why = o.launchError.empty() && !o.timedOut ? reasonFromLog(runJobs[j].logPath) : "";
+			m.error = why.empty() ? o.describe() : why;
+		}
+		std::ostringstream line;
+		line << "keygrid-batch: " << ++done << " of " << total << " runs done: " << m.dataset << " / " << m.config;
+		if (repeats > 1) line << " #" << m.repeat;
+		if (m.ok())
+		{
+			line << ": " << (m.tracked ? *m.tracked : 0) << "/" << (m.frames ? *m.frames : 0) << " tracked";
+			if (m.ateRmse) line << ", ATE " << fmtCentimetres(*m.ateRmse);
+		}
+		else
+			line << ": FAILED: " << m.error;
+		std::cerr << line.str() << " (" << fmtSeconds(o.seconds) << ")\n";
+	});
+
+	// 4. Tables.
+	const auto rows = aggregateRuns(runs);
+	std::ostringstream md;
+	md << "# " << spec.batch.title << "\n\n"
+	   << "Command: `" << opts.commandLine << "` (started " << started << ", " << machine << "; " << jobs
+	   << " runs at a time, " << repeats << (repeats > 1 ? " repeats, medians" : " repeat") << ").\n\n"
+	   << "Every run: `keygrid-slam --config " << (out / "_configs").string() << "/CONFIG.ini --input INPUT --output "
+	   << out.string() << "/DATASET/CONFIG" << (repeats > 1 ? "/rN" : "") << " --gt GT --quiet`.\n\n";
+	for (const auto& d : spec.datasets)
+		md << "* dataset `" << d.name << "`: "
+		   << (d.generated() ? "`keygrid-sim --scene " + d.scene + (d.seed ? " --seed " + std::to_string(*d.seed) : "") +
+								   (d.frames ? " --frames " + std::to_string(*d.frames) : "") + "`"
+							 : "`" + d.input + "`")
+		   << (d.maxFrames > 0 ? ", first " + std::to_string(d.maxFrames) + " frames" : "") << "\n";
+	for (const auto& c : spec.configs)
+	{
+		md << "* config `" << c.name << "`: `" << c.file << "`";
+		for (const auto& o : c.overrides)
+			md << (&o == &c.overrides.front() ? " with `" : ", `") << o.section << "." << o.key << " = " << o.value << "`";
+		md << "\n";
+	}
+	md << "\n" << resultsMarkdown(rows);
+	writeFileAtomically((out / "results.md").string(), md.str());
+	writeFileAtomically((out / "results.csv").string(), resultsCsv(rows));
+	writeFileAtomically((out / "runs.csv").string(), runsCsv(runs));
+	return runs;
+}
+
+int BatchApp::run(int argc, const char* const* argv)
+{
+	return runApp("keygrid-batch", [&] {
+		core::CommandLine cl(
+			"keygrid-batch",
+			"Runs an experiment: every dataset x configuration of EXPERIMENT.ini (format in\n"
+			"doc/user-guide.md, \"Batch experiments\") as parallel keygrid-slam processes, after\n"
+			"generating the synthetic datasets with keygrid-sim. Writes OUT/results.md and\n"
+			"OUT/results.csv (one row per dataset and config, medians over repeats: frames, tracked,\n"
+			"fps, ATE RMSE, keyframes, landmarks, loop closures, error), OUT/runs.csv (every run) and\n"
+			"each run's outputs in OUT/DATASET/CONFIG[/rN]. Exit code 1 when a run failed.");
+		cl.positionals("EXPERIMENT.ini", "the experiment")
+			.option("output", "DIR", "output folder, overriding [batch] output")
+			.option("jobs", "N", "runs at the same time, overriding [batch] jobs", false, "2")
+			.option("repeats", "N", "runs per (dataset, config), overriding [batch] repeats", false, "1")
+			.option("bin-dir", "DIR", "folder of keygrid-slam and keygrid-sim", false, "this program's folder")
+			.flag("dry-run", "print the commands instead of running them");
+		if (!cl.parse(argc, argv)) return 0;
+		if (cl.positional().size() != 1) throw core::CommandLineError("expected one EXPERIMENT.ini");
+		ExperimentSpec spec = ExperimentSpec::FromFile(cl.positional()[0]);
+		if (cl.has("output")) spec.batch.output = cl.get("output");
+		if (cl.has("jobs"))
+		{
+			const long n = cl.getInt("jobs");
+			if (n < 1 || n > 64) throw core::CommandLineError("--jobs must be in [1, 64]");
+			spec.batch.jobs = static_cast<int>(n);
+		}
+		if (cl.has("repeats"))
+		{
+			const long n = cl.getInt("repeats");
+			if (n < 1 || n > 1000) throw core::CommandLineError("--repeats must be in [1, 1000]");
+			spec.batch.repeats = static_cast<int>(n);
+		}
+		if (spec.batch.output.empty()) throw core::CommandLineError("no output folder: set [batch] output or give --output");
+		BatchRunOptions o;
+		if (cl.has("bin-dir")) o.binDir = cl.get("bin-dir");
+		o.dryRun = cl.flagSet("dry-run");
+		o.commandLine = "keygrid-batch";
+		for (int i = 1; i < argc; i++) o.commandLine += std::string(" ") + argv[i];
+		const auto runs = runBatch(spec, o);
+		if (o.dryRun) return 0;
+		std::cout << resultsMarkdown(aggregateRuns(runs)) << "\nresults in " << spec.batch.output << "/results.md and "
+				  << spec.batch.output << "/results.csv\n";
+		std::size_t failed = 0;
+		for (const auto& r : runs) failed += r.ok() ? 0 : 1;
+		if (failed)
+		{
+			std::cerr << "keygrid-batch: " << failed << " of " << runs.size() << " runs failed (reasons in the table)\n";
+			return 1;
+		}
+		return 0;
+	});
+}
+
+}  // namespace keygrid::slam
