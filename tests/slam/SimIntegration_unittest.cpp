@@ -3,7 +3,10 @@
 // scored against the simulator's exact ground truth.
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/slam/apps/SlamApp.h>
+#include <keygrid/maps/CHOCPointsMap.h>
+#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
+#include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 
 #include "TestData.h"
@@ -29,7 +32,7 @@ TEST(SimIntegration, ShippedSimConfigTracksAGeneratedSequenceWithMaps)
 	ASSERT_TRUE(r.ateRmse.has_value());
 	// Kinect-like noise on, exact ground truth: measured 3.2 mm on 2026-11-21.
 	EXPECT_LT(*r.ateRmse, 0.01);
-	for (const char* f : {"trajectory.txt", "keyframes.txt", "report.json", "map_2d.pgm", "map_2d.yaml", "map_2d.png", "map_3d.bt", "map_3d.ply"})
+	for (const char* f : {"trajectory.txt", "keyframes.txt", "report.json", "map_2d.pgm", "map_2d.yaml", "map_2d.png", "map_3d.bt", "map_3d.ply", "hoc_points.ply", "keyframes.simplemap", "scene.3Dscene"})
 		EXPECT_TRUE(mrpt::system::fileExists(o.output + "/" + f)) << f;
 	// The 2D map is a valid ROS map_server map with obstacles and free space.
 	mrpt::maps::COccupancyGridMap2D grid;
@@ -45,4 +48,20 @@ TEST(SimIntegration, ShippedSimConfigTracksAGeneratedSequenceWithMaps)
 	EXPECT_GT(occupied, 50);
 	EXPECT_GT(freeCells, 500);
 	EXPECT_GT(mrpt::system::getFileSize(o.output + "/map_3d.bt"), 1000u);
+	// The serialized maps load back as their classes; the HOC map holds as many points as the
+	// PLY export.
+	for (const auto& [file, cls] : std::vector<std::pair<std::string, std::string>>{
+			 {"map_2d.bin", "keygrid::CISMOccupancyGrid2D"}, {"map_3d.bin", "keygrid::CSubmappedOccupancyGrid3D"}, {"hoc_points.bin", "keygrid::CHOCPointsMap"}})
+	{
+		mrpt::io::CFileGZInputStream in(o.output + "/" + file);
+		const auto obj = mrpt::serialization::archiveFrom(in).ReadObject();
+		ASSERT_TRUE(obj) << file;
+		EXPECT_EQ(std::string(obj->GetRuntimeClass()->className), cls) << file;
+		if (const auto hoc = std::dynamic_pointer_cast<CHOCPointsMap>(obj))
+		{
+			EXPECT_GT(hoc->size(), 100u);
+			const std::string ply = test::readTextFile(o.output + "/hoc_points.ply");
+			EXPECT_NE(ply.find("element vertex " + std::to_string(hoc->size()) + "\n"), std::string::npos);
+		}
+	}
 }

@@ -1,6 +1,7 @@
 // keygrid-slam end to end: the shipped INI on real TUM frames (when ../shared/data is present),
 // determinism, threaded == sequential, report contents and bad inputs.
 #include <keygrid/core/TumTrajectory.h>
+#include <keygrid/slam/SlamConfig.h>
 #include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/system/filesystem.h>
 
@@ -127,4 +128,29 @@ TEST(SlamApp, RealKinectRawlogFrameInitialisesTheMap)
 	EXPECT_EQ(r.tracked, 1u);
 	const std::string js = test::readTextFile(o.output + "/report.json");
 	EXPECT_GT(test::jsonNumber(js, "landmarks"), 300);
+}
+
+TEST(SlamApp, UnknownKeysOfSlamSectionsAreNamedAndShippedConfigsAreClean)
+{
+	const std::string dir = test::scratchDir("slam_unknown_keys");
+	for (const char* shipped : {"sim.ini", "tum_fr1.ini", "tum_fr2.ini", "tum_fr3.ini", "kinect_openni2.ini"})
+		EXPECT_NO_THROW(slam::SlamConfig::FromFile(test::sourceDir() + "/config/" + shipped)) << shipped;
+	for (const std::string& bad : {"[tracker]\nradius_predicton = 5\n", "[hoc]\nenable = true\n", "[slam]\nmodes = threaded\n"})
+	{
+		const std::string path = dir + "/bad.ini";
+		std::ofstream(path) << bad;
+		const std::string key = bad.substr(bad.find('\n') + 1, bad.find(' ', bad.find('\n')) - bad.find('\n') - 1);
+		try
+		{
+			slam::SlamConfig::FromFile(path);
+			ADD_FAILURE() << "accepted " << bad;
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+		}
+	}
+	// Sections that are not SlamConfig's (map plugins, MRPT) are left to their owners.
+	std::ofstream(dir + "/other.ini") << "[MappingApplication]\npointsMap_count = 1\n[custom]\nanything = 1\n";
+	EXPECT_NO_THROW(slam::SlamConfig::FromFile(dir + "/other.ini"));
 }

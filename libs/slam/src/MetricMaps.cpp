@@ -2,6 +2,7 @@
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <keygrid/slam/MetricMaps.h>
+#include <keygrid/slam/SimpleMapExport.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/maps/TMetricMapTypesRegistry.h>
 
@@ -236,18 +237,21 @@ std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const
 		{
 			ism->saveAsRosMapServer(dir + "/map_2d" + suffix + ".yaml");
 			ism->saveAsImage(dir + "/map_2d" + suffix + ".png");
-			files.insert(files.end(), {"map_2d" + suffix + ".yaml", "map_2d" + suffix + ".pgm", "map_2d" + suffix + ".png"});
+			saveGzAtomically(*ism, dir + "/map_2d" + suffix + ".bin");
+			files.insert(files.end(), {"map_2d" + suffix + ".yaml", "map_2d" + suffix + ".pgm", "map_2d" + suffix + ".png", "map_2d" + suffix + ".bin"});
 		}
 		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
 		{
 			g3->saveAsOctomapBinary(dir + "/map_3d" + suffix + ".bt");
 			g3->saveOccupiedAsPly(dir + "/map_3d" + suffix + ".ply");
-			files.insert(files.end(), {"map_3d" + suffix + ".bt", "map_3d" + suffix + ".ply"});
+			saveGzAtomically(*g3, dir + "/map_3d" + suffix + ".bin");
+			files.insert(files.end(), {"map_3d" + suffix + ".bt", "map_3d" + suffix + ".ply", "map_3d" + suffix + ".bin"});
 		}
 		else if (const auto* hoc = dynamic_cast<const CHOCPointsMap*>(m.get()))
 		{
 			hoc->saveAsPly(dir + "/hoc_points" + suffix + ".ply");
-			files.push_back("hoc_points" + suffix + ".ply");
+			saveGzAtomically(*hoc, dir + "/hoc_points" + suffix + ".bin");
+			files.insert(files.end(), {"hoc_points" + suffix + ".ply", "hoc_points" + suffix + ".bin"});
 		}
 		else
 		{

@@ -1,7 +1,9 @@
+#include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <mrpt/config/CConfigFile.h>
 #include <mrpt/system/filesystem.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace keygrid::slam
@@ -42,6 +44,25 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame against the final map");
 }
 
+void SlamConfig::checkKnownKeys(const mrpt::config::CConfigFileBase& c)
+{
+	// The sections SlamConfig owns, with the keys its saveToConfigFile writes. (Map sections
+	// belong to the plugins; MetricMaps checks those by type.)
+	for (const auto& sec : slamConfigReference())
+	{
+		if (!c.sectionExists(sec.name)) continue;
+		std::vector<std::string> keys;
+		c.getAllKeys(sec.name, keys);
+		for (const auto& k : keys)
+		{
+			const bool known = std::any_of(sec.keys.begin(), sec.keys.end(), [&](const IniKey& r) { return r.key == k; });
+			if (!known)
+				throw std::invalid_argument(
+					"[" + sec.name + "] " + k + ": unknown key (typo? `keygrid-slam --dump-config` lists every key)");
+		}
+	}
+}
+
 SlamConfig SlamConfig::FromFile(const std::string& path)
 {
 	if (!mrpt::system::fileExists(path)) throw std::invalid_argument("config file '" + path + "' does not exist");
@@ -50,6 +71,7 @@ SlamConfig SlamConfig::FromFile(const std::string& path)
 	try
 	{
 		c.loadFromConfigFile(cfg);
+		checkKnownKeys(cfg);
 	}
 	catch (const std::exception& e)
 	{

@@ -71,7 +71,9 @@ class MetricMaps
 	/** Tells the maps the camera is back in mapped space (3D grid: localization mode). */
 	void notifyLoopClosure();
 
-	/** Writes each map's outputs into dir (map_2d.{pgm,yaml,png}, map_3d.bt, map_3d.ply, ...);
+	/** Writes each map's outputs into dir (map_2d.{pgm,yaml,png}, map_3d.bt, map_3d.ply,
+	 * hoc_points.ply, and each keygrid map serialized, gz-compressed: map_2d.bin, map_3d.bin,
+	 * hoc_points.bin, readable with CFileGZInputStream + archiveFrom >> map);
 	 * returns the file names written. */
 	std::vector<std::string> writeOutputs(const std::string& dir) const;
 	/** JSON array describing each map (class, size, outputs). */

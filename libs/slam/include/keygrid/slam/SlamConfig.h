@@ -45,6 +45,10 @@ struct SlamConfig
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;
 	/** Reads an INI file; throws std::invalid_argument naming the file and the bad key. */
+	/** Throws std::invalid_argument naming the first key of a SlamConfig section ([slam],
+	 * [tracker], [hoc], ...) that no option reads. */
+	static void checkKnownKeys(const mrpt::config::CConfigFileBase& cfg);
+	/** Loads, validates and checks for unknown keys. */
 	static SlamConfig FromFile(const std::string& path);
 };
 
