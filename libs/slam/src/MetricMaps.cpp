@@ -7,6 +7,7 @@
 #include <mrpt/maps/TMetricMapTypesRegistry.h>
 
 #include <chrono>
+#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
@@ -225,6 +226,31 @@ void MetricMaps::notifyLoopClosure()
 }
 
 std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const
+{
+	// Atomic outputs: everything is written into a scratch folder beside the final files, then
+	// each file is renamed into place (also what was written before an error).
+	namespace fs = std::filesystem;
+	const fs::path tmp = fs::path(dir) / ".maps.tmp";
+	fs::remove_all(tmp);
+	fs::create_directories(tmp);
+	auto publish = [&] {
+		for (const auto& e : fs::directory_iterator(tmp)) fs::rename(e.path(), fs::path(dir) / e.path().filename());
+		fs::remove_all(tmp);
+	};
+	try
+	{
+		auto files = writeOutputsInto(tmp.string());
+		publish();
+		return files;
+	}
+	catch (...)
+	{
+		publish();
+		throw;
+	}
+}
+
+std::vector<std::string> MetricMaps::writeOutputsInto(const std::string& dir) const
 {
 	std::vector<std::string> files;
 	std::map<std::string, int> seen;

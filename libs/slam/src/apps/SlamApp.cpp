@@ -264,7 +264,8 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	{
 		try
 		{
-			hocPointsFromLandmarks(sys.map(), cfg.tracker.hoc).saveAsPly(o.output + "/hoc_points.ply");
+			hocPointsFromLandmarks(sys.map(), cfg.tracker.hoc).saveAsPly(o.output + "/hoc_points.ply.tmp");
+			std::rename((o.output + "/hoc_points.ply.tmp").c_str(), (o.output + "/hoc_points.ply").c_str());
 		}
 		catch (const std::exception& e)
 		{

@@ -73,13 +73,16 @@ class MetricMaps
 
 	/** Writes each map's outputs into dir (map_2d.{pgm,yaml,png}, map_3d.bt, map_3d.ply,
 	 * hoc_points.ply, and each keygrid map serialized, gz-compressed: map_2d.bin, map_3d.bin,
-	 * hoc_points.bin, readable with CFileGZInputStream + archiveFrom >> map);
+	 * hoc_points.bin, readable with CFileGZInputStream + archiveFrom >> map); each file appears
+	 * atomically (written in DIR/.maps.tmp, then renamed);
 	 * returns the file names written. */
 	std::vector<std::string> writeOutputs(const std::string& dir) const;
 	/** JSON array describing each map (class, size, outputs). */
 	std::string summaryJson() const;
 
    private:
+	std::vector<std::string> writeOutputsInto(const std::string& dir) const;
+
 	mrpt::maps::CMultiMetricMap m_maps;
 	MapFeedOptions m_feed;
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> m_insertedPoses;
