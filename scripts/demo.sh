@@ -38,4 +38,7 @@ echo "  $out/sim/                 rendered sequence (sequence.rawlog, tum/, grou
 echo "  $out/slam/trajectory.txt  estimated trajectory (TUM format); report.json, frames.csv"
 echo "  $out/slam/map_2d.png      2D navigation grid (also map_2d.pgm + map_2d.yaml for map_server)"
 echo "  $out/slam/map_3d.bt       3D occupancy grid (octovis $out/slam/map_3d.bt); map_3d.ply"
+echo "  $out/slam/hoc_points.ply  landmarks coloured by their HOC weight; *.bin = the maps serialized"
+echo "  $out/slam/scene.3Dscene   everything for SceneViewer3D -l build/libs/maps/libkeygrid_maps.so"
+echo "  $out/slam/keyframes.simplemap  keyframe poses + observations for MRPT's observations2map"
 echo "  RawLogViewer $out/sim/sequence.rawlog   to browse the input"

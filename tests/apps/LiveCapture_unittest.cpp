@@ -320,12 +320,13 @@ bool waitForText(const std::string& log, const std::string& text, double seconds
 }
 
 /** keygrid-sim's 90-frame 640x480 test sequence: several seconds of work for keygrid-slam,
- * so a run is surely still going when the test interrupts it. */
+ * so a run is surely still going when the test interrupts it. Generated once per test process. */
 const std::size_t kLongFrames = 90;
 std::string longRawlog()
 {
 	static const std::string path = [] {
-		const std::string dir = test::scratchDir("interrupt_input");
+		// One folder per test: ctest runs the tests of this file as parallel processes.
+		const std::string dir = test::scratchDir(std::string("interrupt_input_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
 		std::string out;
 		const int rc = test::runCommand(
 			test::toolPath("keygrid-sim") + " --quiet --scene " + test::dataDir() + "/sim/room_arc.ini --output " + dir, &out);

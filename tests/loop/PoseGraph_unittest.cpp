@@ -272,7 +272,7 @@ TEST(PoseGraph, G2oRoundTrip)
 	for (const auto& [id, T] : g.poses()) EXPECT_TRUE(r.pose(id).isApprox(T, 1e-9)) << id;
 	EXPECT_TRUE(g.pose(5).isApprox(r.pose(5)));
 
-	const std::string bad = keygrid::test::scratchDir("loop_g2o") + "/bad.g2o";
+	const std::string bad = keygrid::test::scratchDir("loop_g2o_bad") + "/bad.g2o";
 	{
 		std::ofstream f(bad);
 		f << "VERTEX_SE3:QUAT 0 0 0 0 0 0 0 1\nEDGE_SE3:QUAT 0 7 0 0 0 0 0 0 1\n";
