@@ -6,12 +6,18 @@
 
 namespace keygrid::core
 {
-bool parseTrimmedDouble(const std::string& text, double& out)
+std::string trimBlanks(const std::string& text)
 {
 	const auto b = text.find_first_not_of(" \t\r\n");
-	if (b == std::string::npos) return false;
+	if (b == std::string::npos) return "";
 	const auto e = text.find_last_not_of(" \t\r\n");
-	return parseDouble(text.substr(b, e - b + 1), out);
+	return text.substr(b, e - b + 1);
+}
+
+bool parseTrimmedDouble(const std::string& text, double& out)
+{
+	const std::string t = trimBlanks(text);
+	return !t.empty() && parseDouble(t, out);
 }
 
 double readFiniteNumber(

@@ -8,6 +8,7 @@
  * is given, and so learns which key each section holds), and their defaults and comments from
  * the definition's dumpToTextStream() (the options' saveToConfigFile output).
  */
+#include <keygrid/core/ConfigReading.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <keygrid/slam/IniReference.h>
@@ -27,13 +28,7 @@ namespace keygrid::slam
 {
 namespace
 {
-std::string trim(const std::string& s)
-{
-	const auto b = s.find_first_not_of(" \t\r\n");
-	if (b == std::string::npos) return "";
-	const auto e = s.find_last_not_of(" \t\r\n");
-	return s.substr(b, e - b + 1);
-}
+std::string trim(const std::string& s) { return core::trimBlanks(s); }
 
 /** MRPT's write(..., comment) stores `value // comment` as the value text. */
 IniKey splitValueAndComment(const std::string& key, const std::string& text)

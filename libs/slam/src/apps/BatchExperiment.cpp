@@ -20,13 +20,7 @@ namespace keygrid::slam
 {
 namespace
 {
-std::string trim(const std::string& s)
-{
-	const auto b = s.find_first_not_of(" \t\r\n");
-	if (b == std::string::npos) return "";
-	const auto e = s.find_last_not_of(" \t\r\n");
-	return s.substr(b, e - b + 1);
-}
+std::string trim(const std::string& s) { return core::trimBlanks(s); }
 
 std::string lower(std::string s)
 {

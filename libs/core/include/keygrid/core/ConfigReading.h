@@ -18,6 +18,9 @@ double readFiniteNumber(
 	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key,
 	double current);
 
+/** `text` without leading and trailing blanks (space, tab, CR, LF). */
+std::string trimBlanks(const std::string& text);
+
 /** Trims blanks and parses a whole finite number (core::parseDouble after trimming). */
 bool parseTrimmedDouble(const std::string& text, double& out);
 
