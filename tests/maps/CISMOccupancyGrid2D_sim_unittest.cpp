@@ -1,8 +1,11 @@
-/** CISMOccupancyGrid2D on keygrid-sim's furnished room (config/sim/room_loop.ini, rendered in
- * process with sensor noise), keyframes at ground-truth poses, scored against the simulator's
- * exact floor plan at 5 cm (issue 6: occupied-cell F1 >= 0.9, free-space accuracy >= 95 %).
- * The full-size experiment (450 frames, and keygrid-slam poses) is
- * tests/benchmarks/maps_ism/ism2d_sim_f1.sh; numbers in doc/maps-ism2d.md. */
+/** CISMOccupancyGrid2D on keygrid-sim's furnished room, rendered in process with sensor noise,
+ * keyframes at ground-truth poses, scored against the simulator's exact floor plan at 5 cm
+ * (issue 6: occupied-cell F1 >= 0.9, free-space accuracy >= 95 %). Two walks through the same
+ * room: config/sim/room_survey.ini (a loop that looks at every wall and piece of furniture: the
+ * issue's bounds) and config/sim/room_loop.ini (a circle in the middle, looking outwards: a
+ * fifth of the plan stays out of view). The full-size experiment (every 10th frame, and
+ * keygrid-slam poses) is tests/benchmarks/maps_ism/ism2d_sim_f1.sh; numbers in
+ * doc/maps-ism2d.md. */
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/OccupancyGridMetrics.h>
 #include <keygrid/core/RgbdObservation.h>
@@ -18,20 +21,18 @@ using namespace keygrid;
 
 namespace
 {
-/** The loop rendered with `keyframes` frames (the trajectory is stretched to that length, so
- * they are spread over the whole circle like every 10th frame of the 450-frame sequence). */
+/** A scene rendered with `keyframes` frames (the trajectory is stretched to that length, so
+ * they are spread over the whole walk like every N-th frame of the full sequence). */
 struct SimRoomRun
 {
 	/** Against the full floor plan, and against its cells the cameras could see. */
 	maps::OccupancyMetrics sparse, dense, sparseVisible, denseVisible;
 };
 
-const SimRoomRun& simRoomRun()
+SimRoomRun runScene(const std::string& sceneName, unsigned keyframes)
 {
-	static const SimRoomRun run = [] {
-		constexpr unsigned kKeyframes = 30;
 		const sim::Scene scene =
-			sim::Scene::loadFromFile(test::sourceDir() + "/config/sim/room_loop.ini", kKeyframes);
+			sim::Scene::loadFromFile(test::sourceDir() + "/config/sim/" + sceneName + ".ini", keyframes);
 		const sim::Simulator simulator(scene, 0);
 		const maps::FloorPlanGrid gt =
 			test::toFloorPlanGrid(sim::floorPlanOfStaticScene(scene, 0.05, 0.1, 1.8));
@@ -40,7 +41,7 @@ const SimRoomRun& simRoomRun()
 		sim::SimFrame f;
 		std::vector<uint8_t> visible;
 		const auto& o = dense.insertionOptions;
-		for (unsigned i = 0; i < kKeyframes; i++)
+		for (unsigned i = 0; i < keyframes; i++)
 		{
 			simulator.frame(i, f);
 			test::markVisibleCells(visible, gt, f.render.depth, f.frame.camera, f.T_world_cam,
@@ -56,32 +57,56 @@ const SimRoomRun& simRoomRun()
 		r.denseVisible = maps::evaluateOccupancy(dense, gtVisible);
 		for (const auto& [name, m] : {std::pair{"sparse", r.sparse}, std::pair{"dense", r.dense},
 				 std::pair{"sparse, visible GT", r.sparseVisible}, std::pair{"dense, visible GT", r.denseVisible}})
-			std::printf("sim room %-18s: occupied P %.3f R %.3f F1 %.3f (GT %zu), free accuracy %.3f (%zu observed; "
+			std::printf("%s %-18s: occupied P %.3f R %.3f F1 %.3f (GT %zu), free accuracy %.3f (%zu observed; "
 						"%.3f away from GT-occupied cells), free precision %.3f\n",
-				name, m.precision, m.recall, m.f1, m.gtOccupied, m.freeAccuracy, m.gtFreeObserved,
+				sceneName.c_str(), name, m.precision, m.recall, m.f1, m.gtOccupied, m.freeAccuracy, m.gtFreeObserved,
 				m.freeAccuracyAwayFromOccupied, m.freePrecision);
 		return r;
-	}();
+}
+
+const SimRoomRun& simRoomRun()
+{
+	static const SimRoomRun run = runScene("room_loop", 30);
+	return run;
+}
+
+const SimRoomRun& simSurveyRun()
+{
+	static const SimRoomRun run = runScene("room_survey", 60);
 	return run;
 }
 }  // namespace
 
-// Issue 6 asks for F1 >= 0.9 and free accuracy >= 95 % against the full floor plan. Measured
-// here (30 keyframes) and in the 450-frame benchmark: dense F1 0.88, free accuracy 0.946 — not
-// met, for two reasons the tests below pin down separately (doc/maps-ism2d.md):
-//  * ~22 % of the plan's occupied cells are never visible from the 1.3 m high camera (the
-//    1.8 m cabinet's top face, the back of the pillar, parts of the table top behind the box);
-//    against the visible part of the plan the dense grid reaches F1 0.99;
-//  * almost all free-space errors lie in the one-cell band next to a wall: the room's surfaces
-//    lie exactly on cell boundaries, the plan marks one side, the noisy depth both; away from
-//    that band the free accuracy is 0.999.
-// The bounds on the full plan are regression bounds below the measured values.
+// The issue's bounds, on the walk that sees the room (measured here with 60 keyframes: see
+// the printed line; 180 keyframes in the benchmark: F1 0.910, free accuracy 0.998).
+TEST(CISMOccupancyGrid2DSim, SurveyDenseDepthMeetsTheFloorPlanBounds)
+{
+	const auto& m = simSurveyRun().dense;
+	EXPECT_GE(m.f1, 0.9);
+	EXPECT_GE(m.freeAccuracy, 0.95);
+	EXPECT_GE(m.precision, 0.99);
+	EXPECT_GT(m.gtFreeObserved, 5000u);
+}
+
+TEST(CISMOccupancyGrid2DSim, SurveySparseKeypointsMatchTheVisiblePlan)
+{
+	// Sparse points leave cells without any point: lower recall, same precision.
+	const auto& m = simSurveyRun().sparse;
+	EXPECT_GE(m.precision, 0.99);
+	EXPECT_GE(m.freeAccuracy, 0.95);
+	EXPECT_GE(simSurveyRun().sparseVisible.f1, 0.88);
+}
+
+// room_loop: ~22 % of the plan's occupied cells are never visible from the circle in the middle
+// (the backs of the shelf, cabinet, pillar and crate, the walls behind them), which caps the
+// recall against the full plan; against the visible part the dense grid reaches F1 0.99. The
+// bounds on the full plan are regression bounds below the measured values.
 TEST(CISMOccupancyGrid2DSim, DenseDepthAtGroundTruthPosesMatchesFloorPlan)
 {
 	const auto& m = simRoomRun().dense;
 	EXPECT_GE(m.precision, 0.99);
 	EXPECT_GE(m.f1, 0.86);
-	EXPECT_GE(m.freeAccuracy, 0.93);
+	EXPECT_GE(m.freeAccuracy, 0.97);
 	EXPECT_GT(m.gtFreeObserved, 5000u);  // most of the 30 m^2 room was observed
 	EXPECT_GE(m.freeAccuracyAwayFromOccupied, 0.99);
 }
@@ -102,6 +127,6 @@ TEST(CISMOccupancyGrid2DSim, SparseKeypointsAtGroundTruthPosesMatchFloorPlan)
 	EXPECT_GE(m.precision, 0.99);
 	EXPECT_GE(m.f1, 0.68);
 	EXPECT_GE(v.f1, 0.78);
-	EXPECT_GE(m.freeAccuracy, 0.93);
+	EXPECT_GE(m.freeAccuracy, 0.97);
 	EXPECT_GE(m.freeAccuracyAwayFromOccupied, 0.99);
 }

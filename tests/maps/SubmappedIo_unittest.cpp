@@ -35,6 +35,7 @@ CSubmappedOccupancyGrid3D twoSubmapMap()
 	m.insertionOptions.integration.logOddsHit = 0.9f;
 	m.morphingOptions.weightExponent = 3.0;
 	m.morphingOptions.interpolation = MorphingOptions::Interpolation::Nearest;
+	m.morphingOptions.maxKeyframesPerBlock = 12;
 	m.likelihoodOptions.decimation = 7;
 	const auto cam = test::smallCamera();
 	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(), 0.0, 1);
@@ -87,11 +88,12 @@ TEST(SubmappedIo, SerializationRoundTrip)
 	EXPECT_EQ(r->insertionOptions.conflict.conflictMinVoxels, 100);
 	EXPECT_EQ(r->morphingOptions.weightExponent, 3.0);
 	EXPECT_EQ(r->morphingOptions.interpolation, MorphingOptions::Interpolation::Nearest);
+	EXPECT_EQ(r->morphingOptions.maxKeyframesPerBlock, 12u);
 	EXPECT_EQ(r->likelihoodOptions.decimation, 7u);
 
 	Probe p;
 	buf.Seek(0);
-	EXPECT_ANY_THROW(p.read(arch, 2));
+	EXPECT_ANY_THROW(p.read(arch, 3));
 }
 
 TEST(SubmappedIo, CreatedFromIniThroughCMultiMetricMap)

@@ -6,7 +6,9 @@
 
 #include <gtest/gtest.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
+#include <mrpt/config/CConfigFileMemory.h>
 
+#include <cmath>
 #include <set>
 
 using namespace keygrid;
@@ -196,4 +198,162 @@ TEST(SubmappedMorphing, TravelWindowFollowsTheKeyframeThatPlacedTheContent)
 	// Without the window keyframe 1's lookup (0.25 m closer: a free voxel) is averaged in.
 	const auto off = build(0.0);
 	EXPECT_LT(off.submap(0).grid.find({0, 0, 40})->logOdds, 2 * hit);
+}
+
+namespace
+{
+/** The room map with a different correction per keyframe (a non-rigid trajectory correction,
+ * so every keyframe maps voxels to other earlier positions), as morphAndMerge input. */
+struct NonRigidCase
+{
+	CSubmappedOccupancyGrid3D map = roomMap();
+	std::vector<MorphKeyframe> keyframes;
+
+	NonRigidCase()
+	{
+		int i = 0;
+		for (const auto& [id, k] : map.keyframes())
+		{
+			MorphKeyframe mk;
+			mk.id = id;
+			mk.submap = k.submap;
+			mk.travelled = k.travelled;
+			mk.camera = k.camera;
+			mk.T_world_cam_old = k.T_world_cam;
+			const CPose3D corr(0.03 * i, -0.02 * i, 0.017 * i, mrpt::DEG2RAD(1.5 * i), mrpt::DEG2RAD(-0.7 * i), 0);
+			mk.T_world_cam_new = corr + k.T_world_cam;
+			keyframes.push_back(mk);
+			++i;
+		}
+	}
+	VoxelBlockGrid morph(const MorphingOptions& o, MorphingStats* st = nullptr) const
+	{
+		return morphAndMerge({&map.submap(0).grid}, keyframes, o, st);
+	}
+};
+}  // namespace
+
+TEST(SubmappedMorphing, MatchesABruteForceWeightedAverage)
+{
+	// Independent implementation of the definition in GridMorphing.h (every keyframe, per-voxel
+	// cone test through insideViewCone, trilinear lookup, travel window, w = 1 / max(z, zMin)^2),
+	// evaluated on every voxel of the morphed grid: the culling and pruning of morphAndMerge
+	// must not change any value the definition gives.
+	const NonRigidCase c;
+	const MorphingOptions o;
+	const VoxelBlockGrid& src = c.map.submap(0).grid;
+	MorphingStats st;
+	const VoxelBlockGrid out = c.morph(o, &st);
+	const double res = src.resolution();
+	std::size_t checked = 0, mismatches = 0;
+	out.forEachKnown([&](const VoxelIndex& vi, const Voxel& v) {
+		const auto X = out.centreOf(vi);
+		double sw = 0, swl = 0;
+		for (const auto& k : c.keyframes)
+		{
+			if (!insideViewCone(X, k.T_world_cam_new, k.camera, o.viewConeMaxRange)) continue;
+			const auto P = k.T_world_cam_old.composePoint(k.T_world_cam_new.inverseComposePoint(X));
+			const double q[3] = {P.x / res - 0.5, P.y / res - 0.5, P.z / res - 0.5};
+			int i0[3];
+			double f[3];
+			for (int a = 0; a < 3; ++a)
+			{
+				const double r = std::round(q[a]);
+				const double qs = std::abs(q[a] - r) < 1e-6 ? r : q[a];
+				i0[a] = static_cast<int>(std::floor(qs));
+				f[a] = qs - i0[a];
+			}
+			double cw = 0, cl = 0;
+			for (int corner = 0; corner < 8; ++corner)
+			{
+				const int d[3] = {corner & 1, (corner >> 1) & 1, (corner >> 2) & 1};
+				double t = 1;
+				for (int a = 0; a < 3; ++a) t *= d[a] ? f[a] : 1 - f[a];
+				const Voxel* s = src.find({i0[0] + d[0], i0[1] + d[1], i0[2] + d[2]});
+				if (t <= 0 || !s || !s->isKnown() || std::abs(s->travelled - k.travelled) > o.travelWindow)
+					continue;
+				cw += t;
+				cl += t * s->logOdds;
+			}
+			if (cw < 0.5) continue;
+			const double z2 = std::pow(X.x - k.T_world_cam_new.x(), 2) +
+				std::pow(X.y - k.T_world_cam_new.y(), 2) + std::pow(X.z - k.T_world_cam_new.z(), 2);
+			const double w = 1.0 / std::max(z2, o.minWeightDistance * o.minWeightDistance);
+			sw += w;
+			swl += w * cl / cw;
+		}
+		if (sw <= 0) return;  // carried or outside every cone: not defined by the average
+		++checked;
+		if (std::abs(v.logOdds - swl / sw) > 1e-4) ++mismatches;
+	});
+	ASSERT_GT(checked, 5000u);
+	EXPECT_EQ(checked, st.morphedVoxels);
+	// Voxel centres exactly on a cone boundary may be decided differently (pixel vs plane test).
+	EXPECT_LE(mismatches, checked / 1000) << mismatches << " of " << checked;
+	RecordProperty("brute_force_checked", std::to_string(checked));
+	RecordProperty("brute_force_mismatches", std::to_string(mismatches));
+}
+
+TEST(SubmappedMorphing, KeyframeLimitAboveTheKeyframeCountChangesNothing)
+{
+	const NonRigidCase c;
+	MorphingOptions o;
+	MorphingStats all, large, one;
+	const VoxelBlockGrid exact = c.morph(o, &all);
+	o.maxKeyframesPerBlock = 1000;
+	EXPECT_TRUE(c.morph(o, &large) == exact);
+	EXPECT_EQ(large.lookups, all.lookups);
+	// One keyframe per block: fewer lookups, a different (approximate) grid.
+	o.maxKeyframesPerBlock = 1;
+	const VoxelBlockGrid approx = c.morph(o, &one);
+	EXPECT_LT(one.lookups, all.lookups);
+	EXPECT_LE(one.blockKeyframePairs, one.evaluatedVoxels / VoxelBlock::kVoxels);
+	EXPECT_FALSE(approx == exact);
+}
+
+TEST(SubmappedMorphing, ResultDoesNotDependOnTheThreadCount)
+{
+	const NonRigidCase c;
+	MorphingOptions o;
+	o.threads = 1;
+	const VoxelBlockGrid one = c.morph(o);
+	for (unsigned t : {2u, 3u, 5u})
+	{
+		o.threads = t;
+		EXPECT_TRUE(c.morph(o) == one) << t << " threads";
+	}
+	o.maxKeyframesPerBlock = 2;
+	o.threads = 1;
+	const VoxelBlockGrid limited = c.morph(o);
+	o.threads = 3;
+	EXPECT_TRUE(c.morph(o) == limited);
+}
+
+TEST(SubmappedMorphing, KeyframeLimitIniRoundTripAndValidation)
+{
+	const std::string sec = "morph";
+	MorphingOptions o;
+	EXPECT_EQ(o.maxKeyframesPerBlock, 0u);
+	mrpt::config::CConfigFileMemory cfg(std::string("[morph]\nmorphMaxKeyframesPerBlock = 12\n"));
+	o.loadFromConfigFile(cfg, sec);
+	EXPECT_EQ(o.maxKeyframesPerBlock, 12u);
+	mrpt::config::CConfigFileMemory saved;
+	o.saveToConfigFile(saved, sec);
+	MorphingOptions back;
+	back.loadFromConfigFile(saved, sec);
+	EXPECT_EQ(back.maxKeyframesPerBlock, 12u);
+	for (const char* bad : {"-1", "2.5", "abc"})
+	{
+		mrpt::config::CConfigFileMemory b(std::string("[morph]\nmorphMaxKeyframesPerBlock = ") + bad + "\n");
+		MorphingOptions x;
+		try
+		{
+			x.loadFromConfigFile(b, sec);
+			ADD_FAILURE() << bad << " must throw";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find("morphMaxKeyframesPerBlock"), std::string::npos) << e.what();
+		}
+	}
 }

@@ -96,7 +96,7 @@ TEST(ShippedScenes, LoadAndMoveWithinTrackableSpeeds)
 	const std::string dir = test::sourceDir() + "/config/sim";
 	const char* names[] = {
 		"room_loop", "corridor_loop", "static_camera_dynamic", "moving_camera_dynamic",
-		"relocalization"};
+		"relocalization", "room_survey"};
 	for (const char* n : names)
 	{
 		const std::string path = dir + "/" + n + ".ini";
@@ -112,7 +112,9 @@ TEST(ShippedScenes, LoadAndMoveWithinTrackableSpeeds)
 				  << w * 180 / M_PI << " deg/s\n";
 		EXPECT_LE(v, 0.5) << n;
 		EXPECT_LE(w * 180 / M_PI, 60.0) << n;
-		EXPECT_LE(s.options.frames, 1200u) << n;  // generated in about a minute at most
+		// Generated in about a minute at most; room_survey (the 2D grid's accuracy benchmark,
+		// not used by tests at full length) walks the whole room and takes four.
+		EXPECT_LE(s.options.frames, std::string(n) == "room_survey" ? 1950u : 1200u) << n;
 		// Loops return to the start: first and (virtual) next-after-last frame coincide.
 		if (s.trajectory.options().loop)
 		{

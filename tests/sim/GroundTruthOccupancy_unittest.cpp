@@ -15,7 +15,7 @@ namespace
 // One static box [lo, hi] (corners off the voxel grid) plus a dynamic one that must be ignored.
 const Eigen::Vector3d lo(0.313, -0.472, 0.0), hi(1.127, 0.261, 1.93);
 
-std::string boxSceneIni()
+std::string boxSceneIni(const Eigen::Vector3d& lo = ::lo, const Eigen::Vector3d& hi = ::hi)
 {
 	const Eigen::Vector3d c = 0.5 * (lo + hi), s = hi - lo;
 	char buf[512];
@@ -32,6 +32,14 @@ std::string boxSceneIni()
 // meets it when a <= h and a + r > l; lies inside the open interior when a > l and a + r <= h.
 bool meets(double a, double r, double l, double h) { return a <= h && a + r > l; }
 bool interior(double a, double r, double l, double h) { return a > l && a + r <= h; }
+// The closed cell [a, a + r] (floor plans: a face on a cell boundary marks both cells); eps
+// absorbs the rounding of a + r for lattice coordinates.
+constexpr double eps = 1e-9;
+bool meetsClosed(double a, double r, double l, double h) { return a <= h + eps && a + r >= l - eps; }
+bool interiorClosed(double a, double r, double l, double h)
+{
+	return a > l + eps && a + r < h - eps;
+}
 }  // namespace
 
 class VoxelResolution : public ::testing::TestWithParam<double>
@@ -92,6 +100,31 @@ TEST(GroundTruthOccupancy, FloorPlanIsTheBoxOutlineInTheBand)
 		}
 	EXPECT_EQ(fp.occupiedCount(), expected);
 	EXPECT_GT(expected, 0u);
+}
+
+TEST(GroundTruthOccupancy, FloorPlanFacesOnCellBoundariesMarkBothCells)
+{
+	// Corners on the 5 cm lattice, like the walls of config/sim/room_loop.ini: each vertical
+	// face lies on a cell boundary, so the closed cells on both sides hold part of it.
+	const double r = 0.05;
+	const Eigen::Vector3d bl(0.5, -0.25, 0.0), bh(1.25, 0.4, 1.95);  // top above the band
+	const sim::Scene scene = test::sceneFromString(boxSceneIni(bl, bh));
+	const sim::FloorPlan fp = sim::floorPlanOfStaticScene(scene, r, 0.1, 1.8);
+	std::size_t expected = 0;
+	for (int cy = 0; cy < fp.height; cy++)
+		for (int cx = 0; cx < fp.width; cx++)
+		{
+			const double ax = fp.origin.x() + cx * r, ay = fp.origin.y() + cy * r;
+			const bool outline = meetsClosed(ax, r, bl.x(), bh.x()) &&
+								 meetsClosed(ay, r, bl.y(), bh.y()) &&
+								 !(interiorClosed(ax, r, bl.x(), bh.x()) &&
+								   interiorClosed(ay, r, bl.y(), bh.y()));
+			expected += outline;
+			ASSERT_EQ(fp.occupiedAt(cx, cy), outline) << "cell " << cx << " " << cy;
+		}
+	EXPECT_EQ(fp.occupiedCount(), expected);
+	// A 15 x 13 cell box: outline rings just inside and just outside the faces.
+	EXPECT_EQ(expected, std::size_t(2 * (15 + 13) - 4 + 2 * (17 + 15) - 4));
 }
 
 TEST(GroundTruthOccupancy, FilesRoundTrip)

@@ -95,7 +95,8 @@ void readGrid(CArchive& in, VoxelBlockGrid& g)
 
 // Version 1 (2026-11-21) adds morphingOptions.interpolation after morphingOptions.threads;
 // version-0 archives load with Nearest, the behaviour they were written with.
-uint8_t CSubmappedOccupancyGrid3D::serializeGetVersion() const { return 1; }
+// Version 2 (2026-11-21) adds morphingOptions.maxKeyframesPerBlock after it (older: 0 = all).
+uint8_t CSubmappedOccupancyGrid3D::serializeGetVersion() const { return 2; }
 
 void CSubmappedOccupancyGrid3D::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -113,7 +114,8 @@ void CSubmappedOccupancyGrid3D::serializeTo(mrpt::serialization::CArchive& out) 
 	out << morphingOptions.viewConeMaxRange << morphingOptions.travelWindow
 		<< morphingOptions.weightExponent
 		<< morphingOptions.minWeightDistance << morphingOptions.keepVoxelsOutsideCones
-		<< uint32_t(morphingOptions.threads) << uint8_t(morphingOptions.interpolation);
+		<< uint32_t(morphingOptions.threads) << uint8_t(morphingOptions.interpolation)
+		<< uint32_t(morphingOptions.maxKeyframesPerBlock);
 	out << uint32_t(likelihoodOptions.decimation) << likelihoodOptions.maxRange
 		<< likelihoodOptions.minProbability;
 	// State.
@@ -152,6 +154,7 @@ void CSubmappedOccupancyGrid3D::serializeFrom(mrpt::serialization::CArchive& in,
 	{
 		case 0:
 		case 1:
+		case 2:
 		{
 			in >> m_resolution;
 			auto& io = insertionOptions.integration;
@@ -177,6 +180,12 @@ void CSubmappedOccupancyGrid3D::serializeFrom(mrpt::serialization::CArchive& in,
 				in >> interp;
 				if (interp > 1) throw std::runtime_error("CSubmappedOccupancyGrid3D: bad morphing interpolation " + std::to_string(interp));
 				morphingOptions.interpolation = static_cast<MorphingOptions::Interpolation>(interp);
+			}
+			morphingOptions.maxKeyframesPerBlock = 0;
+			if (version >= 2)
+			{
+				in >> u1;
+				morphingOptions.maxKeyframesPerBlock = u1;
 			}
 			in >> u1 >> likelihoodOptions.maxRange >> likelihoodOptions.minProbability;
 			likelihoodOptions.decimation = u1;

@@ -222,8 +222,14 @@ FloorPlan floorPlanOfStaticScene(const Scene& scene, double resolution, double z
 		o.shape.sampleSurface(resolution / 2, [&](const Eigen::Vector3d& pl) {
 			const Eigen::Vector3d p = o.T_world_obj * pl;
 			if (p.z() < zMin || p.z() > zMax) return;
-			const auto c = fp.cellOf(p.x(), p.y());
-			if (fp.inside(c[0], c[1])) fp.occupied[c[1] * fp.width + c[0]] = 1;
+			// Closed cells: a point on a boundary (within the tolerance) marks both neighbours.
+			const double e = kFloorPlanBoundaryTolerance;
+			for (const double dx : {-e, e})
+				for (const double dy : {-e, e})
+				{
+					const auto c = fp.cellOf(p.x() + dx, p.y() + dy);
+					if (fp.inside(c[0], c[1])) fp.occupied[c[1] * fp.width + c[0]] = 1;
+				}
 		});
 	}
 	return fp;

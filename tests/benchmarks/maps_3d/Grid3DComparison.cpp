@@ -10,6 +10,7 @@
  *
  * Usage: keygrid_bench_maps_3d [--tum DIR] [--rawlog FILE] [--frames N] [--stride K]
  *        [--res M] [--max-range M] [--no-mrpt] [--repeat R] [--morph-window M]
+ *        [--morph-k K1,K2,..] (also morph with at most K keyframes per block, each K)
  */
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/core/RgbdObservation.h>
@@ -49,6 +50,7 @@ struct Args
 	double res = 0.05, maxRange = 4.0;
 	bool mrpt = true;
 	double morphWindow = -1;  // < 0: the MorphingOptions default
+	std::vector<unsigned> morphK;  // --morph-k: also morph with these maxKeyframesPerBlock
 	double conflictTravel = -1;  // < 0: the ConflictOptions default
 	double driftM = 0.2, driftDeg = 6.0;  // synthetic drift at the last frame
 	std::string gtVoxels;  // keygrid-sim occupancy_voxels.txt (optional)
@@ -414,10 +416,34 @@ void runCorrection(const std::vector<BenchFrame>& frames, const Args& a)
 		cpuB, cpuBn, cpuC, cpuC / std::max(cpuB, 1e-9), cpuC / std::max(cpuBn, 1e-9), ms.evaluatedVoxels);
 	std::printf("nearest lookups: F1(b')/F1(c) = %.3f, time(c)/time(b') = %.2f\n", sbn.f1 / std::max(sc.f1, 1e-9),
 		rs.seconds / std::max(msn.seconds, 1e-9));
-	std::printf("F1(b)/F1(c) = %.3f, time(c)/time(b) = %.2f; morphing: %zu source voxels, %zu morphed, "
-				"%zu carried, %zu lookups\n",
+	std::printf("F1(b)/F1(c) = %.4f, time(c)/time(b) = %.2f; morphing: %zu source voxels, %zu morphed, "
+				"%zu carried, %zu (block, keyframe) pairs, %zu lookups attempted, %zu averaged\n",
 		sb.f1 / std::max(sc.f1, 1e-9), rs.seconds / std::max(ms.seconds, 1e-9), ms.sourceVoxels,
-		ms.morphedVoxels, ms.carriedVoxels, ms.lookups);
+		ms.morphedVoxels, ms.carriedVoxels, ms.blockKeyframePairs, ms.attemptedLookups, ms.lookups);
+	// The same morphing (trilinear) with at most K keyframes per corrected block.
+	struct KRun
+	{
+		unsigned k;
+		double cpu;
+		MorphingStats st;
+		VoxelBlockGrid grid;
+	};
+	std::vector<KRun> kRuns;
+	for (const unsigned k : a.morphK)
+	{
+		CSubmappedOccupancyGrid3D mk = mapA;
+		mk.morphingOptions.interpolation = MorphingOptions::Interpolation::Trilinear;
+		mk.morphingOptions.maxKeyframesPerBlock = k;
+		c0 = processCpu();
+		const MorphingStats st = mk.morphAndMergeSubmaps(corr);
+		const double cpu = processCpu() - c0;
+		const Score sk = score(mk.submap(0).grid, ref);
+		std::printf("(b) with morphMaxKeyframesPerBlock %3u: P %.3f R %.3f F1 %.4f -> F1(b)/F1(c) %.4f; "
+					"CPU %.3f s -> (c)/(b) %.2f; %zu pairs, %zu attempted, %zu averaged\n",
+			k, sk.precision, sk.recall, sk.f1, sk.f1 / std::max(sc.f1, 1e-9), cpu, cpuC / std::max(cpu, 1e-9),
+			st.blockKeyframePairs, st.attemptedLookups, st.lookups);
+		kRuns.push_back({k, cpu, st, mk.submap(0).grid});
+	}
 	for (std::size_t s = 0; s < mapA.numSubmaps(); ++s)
 		std::printf("  submap %zu: anchor keyframe %llu, %zu keyframes\n", s,
 			static_cast<unsigned long long>(mapA.submap(s).anchorKeyframe),
@@ -464,6 +490,12 @@ void runCorrection(const std::vector<BenchFrame>& frames, const Args& a)
 	std::printf("%-40s %9.3f %9.3f %9.3f\n", "(d) ground-truth poses", gd.precision, gd.recall, gd.f1);
 	std::printf("F1(b)/F1(c) = %.3f (nearest: %.3f), F1(c)/F1(a) = %.3f\n", gb.f1 / std::max(gc.f1, 1e-9),
 		gbn.f1 / std::max(gc.f1, 1e-9), gc.f1 / std::max(ga.f1, 1e-9));
+	for (const KRun& r : kRuns)
+	{
+		const Score gk = score(r.grid, gt);
+		std::printf("(b) with morphMaxKeyframesPerBlock %3u vs simulator GT: P %.3f R %.3f F1 %.4f -> F1(b)/F1(c) %.4f\n",
+			r.k, gk.precision, gk.recall, gk.f1, gk.f1 / std::max(gc.f1, 1e-9));
+	}
 	// keygrid-slam's own map_3d.bt (its world = its first camera frame): carried into the sim
 	// world by the Umeyama alignment of its trajectory to the ground truth, voxel centres mapped
 	// to the nearest sim voxel (this resampling alone costs some F1: it is not axis aligned).
@@ -591,6 +623,12 @@ int main(int argc, char** argv)
 		else if (k == "--max-range") a.maxRange = std::stod(val());
 		else if (k == "--no-mrpt") a.mrpt = false;
 		else if (k == "--morph-window") a.morphWindow = std::stod(val());
+		else if (k == "--morph-k")
+		{
+			std::istringstream ls(val());
+			std::string tok;
+			while (std::getline(ls, tok, ',')) a.morphK.push_back(unsigned(std::stoul(tok)));
+		}
 		else if (k == "--conflict-travel") a.conflictTravel = std::stod(val());
 		else if (k == "--verbose") a.verbose = true;
 		else if (k == "--profile") a.profile = true;
@@ -607,7 +645,7 @@ int main(int argc, char** argv)
 		else
 		{
 			std::fprintf(stderr, "usage: %s [--tum DIR] [--rawlog FILE] [--frames N] [--stride K] "
-				"[--res M] [--max-range M] [--repeat R] [--no-mrpt] [--morph-window M] [--conflict-travel M] [--drift M DEG] [--sim DIR] [--verbose] [--profile]\n", argv[0]);
+				"[--res M] [--max-range M] [--repeat R] [--no-mrpt] [--morph-window M] [--morph-k K1,K2,..] [--conflict-travel M] [--drift M DEG] [--sim DIR] [--verbose] [--profile]\n", argv[0]);
 			return k == "--help" ? 0 : 1;
 		}
 	}

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Issue 6 accuracy benchmark: CISMOccupancyGrid2D against keygrid-sim's floor plan (5 cm cells)
-# on config/sim/room_loop.ini, with ground-truth poses and with keygrid-slam's poses, sparse
-# (ORB keypoints + depth) and dense input, and keygrid-slam's own map_2d (config/sim.ini, i.e.
-# sparse map points and RANSAC floor; and the same config with ism2d_input = dense).
-#   tests/benchmarks/maps_ism/ism2d_sim_f1.sh [BUILD_DIR] [OUT_DIR] [EVERY]
+# on a room scene (default config/sim/room_survey.ini; also run it with room_loop.ini), with
+# ground-truth poses and with keygrid-slam's poses, sparse (ORB keypoints + depth) and dense
+# input, and keygrid-slam's own map_2d (config/sim.ini, i.e. sparse map points and RANSAC floor;
+# and the same config with ism2d_input = dense).
+#   tests/benchmarks/maps_ism/ism2d_sim_f1.sh [BUILD_DIR] [OUT_DIR] [EVERY] [SCENE_INI]
 # Needs the targets keygrid-sim keygrid-slam keygrid_ism2d_sim_eval (KEYGRID_BUILD_BENCHMARKS=ON).
 # Results and their discussion: doc/maps-ism2d.md.
 set -euo pipefail
@@ -12,7 +13,7 @@ root="$(cd "$here/../../.." && pwd)"
 build="${1:-$root/build}"
 out="${2:-$(mktemp -d)}"
 every="${3:-10}"
-scene="$root/config/sim/room_loop.ini"
+scene="$(realpath "${4:-$root/config/sim/room_survey.ini}")"
 eval="$build/bin/keygrid_ism2d_sim_eval"
 mkdir -p "$out"
 [ -f "$out/room/floorplan.yaml" ] || "$build/bin/keygrid-sim" --scene "$scene" --output "$out/room"

@@ -84,7 +84,14 @@ VoxelSet voxeliseStaticScene(
 	const Scene& scene, double resolution, const Eigen::Vector3d& origin = Eigen::Vector3d::Zero());
 
 /** Cells crossed by static surfaces with zMin <= z <= zMax; the grid covers the static
- * objects' bounds plus one cell, its origin on a multiple of the resolution. */
+ * objects' bounds plus one cell, its origin on a multiple of the resolution.
+ * A surface counts for every *closed* cell it touches: a wall lying exactly on the line between
+ * two cells (the usual case for walls at whole-metre coordinates and 5 cm cells) marks both,
+ * since either cell holds a point of it and a sensor's points scatter into both. With half-open
+ * cells the choice would depend on the side the room is on (x = 0 inside, x = 6 outside).
+ * "Exactly" means within kFloorPlanBoundaryTolerance. */
 FloorPlan floorPlanOfStaticScene(const Scene& scene, double resolution, double zMin, double zMax);
 
+/** [m] distance to a cell boundary under which a surface point counts for both cells. */
+constexpr double kFloorPlanBoundaryTolerance = 1e-7;
 }  // namespace keygrid::sim
