@@ -233,14 +233,14 @@ struct NonRigidCase
 };
 }  // namespace
 
-TEST(SubmappedMorphing, MatchesABruteForceWeightedAverage)
+namespace
 {
-	// Independent implementation of the definition in GridMorphing.h (every keyframe, per-voxel
-	// cone test through insideViewCone, trilinear lookup, travel window, w = 1 / max(z, zMin)^2),
-	// evaluated on every voxel of the morphed grid: the culling and pruning of morphAndMerge
-	// must not change any value the definition gives.
-	const NonRigidCase c;
-	const MorphingOptions o;
+/** Independent implementation of the definition in GridMorphing.h (every keyframe, per-voxel
+ * cone test through insideViewCone, trilinear lookup, travel window (0 = off), w = 1 / max(z,
+ * zMin)^2), evaluated on every voxel of the morphed grid: the culling and pruning of
+ * morphAndMerge must not change any value the definition gives. */
+void expectTheBruteForceWeightedAverage(const NonRigidCase& c, const MorphingOptions& o)
+{
 	const VoxelBlockGrid& src = c.map.submap(0).grid;
 	MorphingStats st;
 	const VoxelBlockGrid out = c.morph(o, &st);
@@ -270,8 +270,8 @@ TEST(SubmappedMorphing, MatchesABruteForceWeightedAverage)
 				double t = 1;
 				for (int a = 0; a < 3; ++a) t *= d[a] ? f[a] : 1 - f[a];
 				const Voxel* s = src.find({i0[0] + d[0], i0[1] + d[1], i0[2] + d[2]});
-				if (t <= 0 || !s || !s->isKnown() || std::abs(s->travelled - k.travelled) > o.travelWindow)
-					continue;
+				if (t <= 0 || !s || !s->isKnown()) continue;
+				if (o.travelWindow > 0 && std::abs(s->travelled - k.travelled) > o.travelWindow) continue;
 				cw += t;
 				cl += t * s->logOdds;
 			}
@@ -290,8 +290,22 @@ TEST(SubmappedMorphing, MatchesABruteForceWeightedAverage)
 	EXPECT_EQ(checked, st.morphedVoxels);
 	// Voxel centres exactly on a cone boundary may be decided differently (pixel vs plane test).
 	EXPECT_LE(mismatches, checked / 1000) << mismatches << " of " << checked;
-	RecordProperty("brute_force_checked", std::to_string(checked));
-	RecordProperty("brute_force_mismatches", std::to_string(mismatches));
+	::testing::Test::RecordProperty("brute_force_checked", std::to_string(checked));
+	::testing::Test::RecordProperty("brute_force_mismatches", std::to_string(mismatches));
+}
+}  // namespace
+
+TEST(SubmappedMorphing, MatchesABruteForceWeightedAverage)
+{
+	expectTheBruteForceWeightedAverage(NonRigidCase(), MorphingOptions());
+}
+
+TEST(SubmappedMorphing, MatchesABruteForceWeightedAverageWithoutTravelWindow)
+{
+	// Window off: every known source voxel counts (the per-block voxel masks hold all of them).
+	MorphingOptions o;
+	o.travelWindow = 0;
+	expectTheBruteForceWeightedAverage(NonRigidCase(), o);
 }
 
 TEST(SubmappedMorphing, KeyframeLimitAboveTheKeyframeCountChangesNothing)

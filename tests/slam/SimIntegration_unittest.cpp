@@ -4,6 +4,7 @@
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/slam/apps/SlamApp.h>
 #include <keygrid/maps/CHOCPointsMap.h>
+#include <keygrid/maps/OccupancyGridMetrics.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/serialization/CArchive.h>
@@ -64,4 +65,34 @@ TEST(SimIntegration, ShippedSimConfigTracksAGeneratedSequenceWithMaps)
 			EXPECT_NE(ply.find("element vertex " + std::to_string(hoc->size()) + "\n"), std::string::npos);
 		}
 	}
+}
+
+// keygrid-slam's 2D grid finds the floor from its keyframes (issue 6): the camera first looks
+// 33 deg down (beyond the 25 deg the floor may be tilted against one camera's "up"), then
+// 20 deg; the floor is estimated from the pooled depth of the first keyframes with the mean
+// "up" of their cameras. Before, it was estimated from the first keyframe's up only and never
+// found here (the grid stayed in the camera frame). The SLAM world is the first camera frame,
+// so the floor frame maps into the sim world (z up, floor z = 0) through the first GT pose.
+TEST(SimIntegration, TwoDimensionalGridFindsTheFloorFromKeyframeDepth)
+{
+	const std::string dir = test::scratchDir("sim_integration_floor");
+	std::string out;
+	ASSERT_EQ(test::runCommand(test::toolPath("keygrid-sim") + " --quiet --scene " + test::dataDir() +
+								   "/sim/room_floor_view.ini --voxel-resolution 0 --output " + dir + "/seq", &out), 0) << out;
+	slam::SlamRunOptions o;
+	o.configPath = test::sourceDir() + "/config/sim.ini";
+	o.input = dir + "/seq/sequence.rawlog";
+	o.output = dir + "/out";
+	o.quiet = true;
+	const auto r = slam::runSlam(o);
+	ASSERT_TRUE(r.error.empty()) << r.error;
+	EXPECT_EQ(r.tracked, 60u);
+	const auto grid = maps::TriStateGrid::loadRosMapServer(o.output + "/map_2d.yaml");
+	ASSERT_TRUE(grid.T_world_floor.has_value());
+	const auto gt = core::readTumTrajectory(dir + "/seq/groundtruth.txt");
+	ASSERT_FALSE(gt.empty());
+	const mrpt::poses::CPose3D T_sim_floor = gt.front().T_world_cam + *grid.T_world_floor;
+	EXPECT_NEAR(T_sim_floor.z(), 0.0, 0.02);  // measured 0.3 mm
+	const auto R = T_sim_floor.getRotationMatrix();
+	EXPECT_GT(R(2, 2), std::cos(1.0 * M_PI / 180.0));  // floor normal vs world z; measured 0.06 deg
 }

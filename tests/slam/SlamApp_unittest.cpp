@@ -135,7 +135,7 @@ TEST(SlamApp, UnknownKeysOfSlamSectionsAreNamedAndShippedConfigsAreClean)
 	const std::string dir = test::scratchDir("slam_unknown_keys");
 	for (const char* shipped : {"sim.ini", "tum_fr1.ini", "tum_fr2.ini", "tum_fr3.ini", "kinect_openni2.ini"})
 		EXPECT_NO_THROW(slam::SlamConfig::FromFile(test::sourceDir() + "/config/" + shipped)) << shipped;
-	for (const std::string& bad : {"[tracker]\nradius_predicton = 5\n", "[hoc]\nenable = true\n", "[slam]\nmodes = threaded\n"})
+	for (const std::string bad : {"[tracker]\nradius_predicton = 5\n", "[hoc]\nenable = true\n", "[slam]\nmodes = threaded\n"})
 	{
 		const std::string path = dir + "/bad.ini";
 		std::ofstream(path) << bad;

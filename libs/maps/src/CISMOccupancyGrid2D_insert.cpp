@@ -303,10 +303,14 @@ bool CISMOccupancyGrid2D::ensureFloorFromDepth(
 }
 
 bool CISMOccupancyGrid2D::estimateFloorFromPoints(
-	const std::vector<TPoint3D>& points_world, const CPose3D& T_world_cam)
+	const std::vector<TPoint3D>& points_world, const CPose3D& T_world_cam,
+	const std::optional<mrpt::math::TVector3D>& upHint)
 {
 	const auto& hint = insertionOptions.floorUpHint;
-	const auto up = hint.norm() > 0 ? hint : T_world_cam.rotateVector(mrpt::math::TVector3D(0, -1, 0));
+	const auto up = hint.norm() > 0 ? hint
+					: upHint && upHint->norm() > 0
+						? *upHint
+						: T_world_cam.rotateVector(mrpt::math::TVector3D(0, -1, 0));
 	const auto fwd = T_world_cam.rotateVector(mrpt::math::TVector3D(0, 0, 1));
 	const auto cam = T_world_cam.translation();
 	const auto plane = maps::estimateFloorPlane(points_world, up, cam, insertionOptions.floorRansac);

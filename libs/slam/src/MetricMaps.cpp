@@ -26,7 +26,7 @@ void MapFeedOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 void MapFeedOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
 	c.write(s, "ism2d_input", ism2dInput, 30, 40, "sparse (map points) | dense (depth image)");
-	c.write(s, "floor_keyframes", floorKeyframes, 30, 40, "sparse 2D grid: first keyframes whose points estimate the floor together");
+	c.write(s, "floor_keyframes", floorKeyframes, 30, 40, "2D grid: first keyframes whose depth samples estimate the floor together");
 }
 
 namespace
@@ -41,6 +41,25 @@ bool knownMapType(const std::string& name)
 			if (part == name) return true;
 	}
 	return false;
+}
+
+/** Floor-estimate samples of a keyframe: its depth on a coarse pixel lattice (every kStep-th
+ * pixel, depth in [kMinDepth, kMaxDepth] m, lens distortion ignored), in the world frame. Depth
+ * samples the floor evenly; map points sit on texture, and few on a floor seen at a grazing
+ * angle, so they often miss it. */
+void appendDepthSamples(const sfm::KeyFrame& kf, std::vector<mrpt::math::TPoint3D>& out)
+{
+	constexpr int kStep = 12;
+	constexpr float kMinDepth = 0.3f, kMaxDepth = 4.0f;
+	const auto& cam = kf.features.camera;
+	for (int r = kStep / 2; r < kf.depth.rows; r += kStep)
+		for (int c = kStep / 2; c < kf.depth.cols; c += kStep)
+		{
+			const float z = kf.depth.at<float>(r, c);
+			if (!(z >= kMinDepth && z <= kMaxDepth)) continue;
+			out.push_back(kf.T_world_cam.composePoint(
+				mrpt::math::TPoint3D((c - cam.cx) * z / cam.fx, (r - cam.cy) * z / cam.fy, z)));
+		}
 }
 
 /** A depth-only observation of a keyframe, for MRPT's own maps. */
@@ -126,38 +145,46 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 	{
 		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
 		{
-			if (m_feed.ism2dInput == "dense" && !kf.depth.empty())
-			{
-				if (!obs) obs = depthObservation(kf);
-				ism->insertKeyframeDepth(id, kf.T_world_cam, *obs);
-			}
-			else
-			{
-				std::vector<mrpt::math::TPoint3D> pts;
+			const bool dense = m_feed.ism2dInput == "dense" && !kf.depth.empty();
+			std::vector<mrpt::math::TPoint3D> pts;
+			if (!dense)
 				for (sfm::LandmarkId l : kf.landmarks)
 					if (l != sfm::kNoLandmark && map.hasLandmark(l))
 					{
 						const auto& p = map.landmark(l).p_world;
 						pts.emplace_back(p.x(), p.y(), p.z());
 					}
-				bool rebuild = false;
-				// Until the floor is found, and then for floor_keyframes keyframes in all.
-				constexpr std::size_t kMaxFloorPoints = 200000;
-				if (ism->insertionOptions.estimateFloorFromDepth && (!ism->floorKnown() || m_floorKeyframes < m_feed.floorKeyframes) &&
-					m_floorPoints.size() < kMaxFloorPoints)
-				{
-					if (!m_firstKeyframePose) m_firstKeyframePose = kf.T_world_cam;
+			bool rebuild = false;
+			// The floor from the first keyframes together (it is often out of view at the first):
+			// until it is found, and then for floor_keyframes keyframes in all. Samples of the
+			// depth image where there is one, else the keyframe's map points.
+			constexpr std::size_t kMaxFloorPoints = 200000;
+			if (ism->insertionOptions.estimateFloorFromDepth && (!ism->floorKnown() || m_floorKeyframes < m_feed.floorKeyframes) &&
+				m_floorPoints.size() < kMaxFloorPoints)
+			{
+				if (!m_firstKeyframePose) m_firstKeyframePose = kf.T_world_cam;
+				if (!kf.depth.empty())
+					appendDepthSamples(kf, m_floorPoints);
+				else
 					m_floorPoints.insert(m_floorPoints.end(), pts.begin(), pts.end());
-					m_floorKeyframes++;
-					const bool known = ism->floorKnown();
-					const auto before = ism->floorPose();
-					if (ism->estimateFloorFromPoints(m_floorPoints, *m_firstKeyframePose) && known)
-						rebuild = (ism->floorPose().asTPose() - before.asTPose()).norm() > 1e-9;
-				}
-				ism->insertKeyframePoints(id, kf.T_world_cam, pts);
-				// A better floor: the keyframes inserted so far are integrated again (cheap).
-				if (rebuild) ism->applyTrajectoryCorrection({});
+				m_floorKeyframes++;
+				// "Up" hint: the mean -y axis of these keyframes. A hand-held camera pitches up
+				// and down; the mean is nearer the true up than the first camera alone.
+				m_floorUpSum = m_floorUpSum + kf.T_world_cam.rotateVector(mrpt::math::TVector3D(0, -1, 0));
+				const bool known = ism->floorKnown();
+				const auto before = ism->floorPose();
+				if (ism->estimateFloorFromPoints(m_floorPoints, *m_firstKeyframePose, m_floorUpSum) && known)
+					rebuild = (ism->floorPose().asTPose() - before.asTPose()).norm() > 1e-9;
 			}
+			if (dense)
+			{
+				if (!obs) obs = depthObservation(kf);
+				ism->insertKeyframeDepth(id, kf.T_world_cam, *obs);
+			}
+			else
+				ism->insertKeyframePoints(id, kf.T_world_cam, pts);
+			// A better floor: the keyframes inserted so far are integrated again (cheap).
+			if (rebuild) ism->applyTrajectoryCorrection({});
 		}
 		else if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get()))
 		{

@@ -190,11 +190,13 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	double lastRebuildSeconds() const { return m_lastRebuildSeconds; }
 	const std::map<uint64_t, KeyframeRays>& keyframes() const { return m_keyframes; }
 	/** Sets the floor frame from a plane estimate on given world points (e.g. SLAM map points).
-	 * The "up" hint is insertionOptions.floorUpHint, or -y of the camera if that is zero; the
-	 * floor frame's origin is the camera footprint and its x axis the camera heading. */
+	 * The "up" hint is insertionOptions.floorUpHint, else `upHint` when given (e.g. the mean -y
+	 * of several cameras), else -y of the camera; the floor frame's origin is the camera
+	 * footprint and its x axis the camera heading. */
 	bool estimateFloorFromPoints(
 		const std::vector<mrpt::math::TPoint3D>& points_world,
-		const mrpt::poses::CPose3D& T_world_cam);
+		const mrpt::poses::CPose3D& T_world_cam,
+		const std::optional<mrpt::math::TVector3D>& upHint = std::nullopt);
 	/** True once the floor frame is known (always when estimateFloorFromDepth is false). */
 	bool floorKnown() const { return !insertionOptions.estimateFloorFromDepth || m_floorEstimated; }
 	/** @} */

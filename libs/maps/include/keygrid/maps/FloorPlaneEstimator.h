@@ -19,10 +19,13 @@ struct FloorPlaneRansacOptions
 {
 	/** Point-to-plane distance of an inlier [m] (Default: 0.02 m) */
 	double inlierDistance{0.02};
-	/** RANSAC hypotheses (Default: 300) */
+	/** Least number of RANSAC hypotheses per plane; more are drawn when minInlierFraction needs
+	 * them (N = log(0.01) / log(1 - f^3), at most 200 000) (Default: 300) */
 	int iterations{300};
-	/** Largest angle between the plane normal and the up hint [deg] (Default: 25 deg) */
-	double maxTiltDeg{25.0};
+	/** Largest angle between the plane normal and the up hint [deg]. The hint is a camera's -y
+	 * axis (or a mean of several), so this must cover how far the camera looks down: a
+	 * hand-held camera aimed at the floor in front of it pitches 25-35 deg (Default: 40 deg) */
+	double maxTiltDeg{40.0};
 	/** Smallest inlier share of all points for a plane to count (Default: 0.10) */
 	double minInlierFraction{0.10};
 	/** The camera must be at least this high above the floor [m] (Default: 0.20 m) */

@@ -35,12 +35,17 @@
  *
  * Cost (none of these changes a value the definition above gives; the unit test compares every
  * voxel with a brute-force evaluation): keyframes are culled per corrected 8^3 block, by the
- * block's box against the view pyramid (all 8 corners inside: no per-voxel cone test) and by
- * whether the source blocks their lookups can reach hold a known voxel in their travel window
- * (per source block: sorted distinct travelled distances with counts and bounding boxes). Per
- * (block, keyframe) the camera-frame and earlier positions are affine in the voxel index; each
- * row of 8 voxels is clipped analytically to the part inside the cone planes and within one
- * voxel of the box of readable source voxels. Optionally (maxKeyframesPerBlock) only the K
+ * block's box against the view pyramid (box centre and half extents against the 5 faces, 1e-9 m
+ * margins: inside everywhere -> no per-voxel cone test) and by whether the source blocks their
+ * lookups can reach hold a known voxel in their travel window (per source block: sorted
+ * distinct travelled distances with counts, bounding boxes and 512-bit voxel masks). Per
+ * (block, keyframe) the camera-frame and earlier positions are affine in the voxel index; the
+ * tests that select voxels (within one voxel of the box of readable source voxels, in front of
+ * the camera, inside the 4 side planes) are clipped per block along z, per slice along y and
+ * per row along x, and where the cone tests hold by more than 1e-9 m the per-voxel cone test is
+ * skipped. Per lookup, the cube of the 8 trilinear corners is first tested against the source
+ * block's mask of voxels known in the window, dilated by one voxel (two blocks' masks when the
+ * cube crosses one block face): no bit, no lookup. Optionally (maxKeyframesPerBlock) only the K
  * keyframes with the most readable voxels times weight are kept per block: an approximation.
  */
 #include <keygrid/core/RgbdCamera.h>
@@ -88,7 +93,7 @@ struct MorphingOptions
 	 * with the largest (known source voxels their lookups can read in their travel window) x
 	 * (weight at the block centre), among those whose cone meets the block. An approximation
 	 * that trades F1 for time: on the corridor benchmark (doc/maps-3d.md) K = 16 cuts the
-	 * morphing CPU time by ~30 % but gives F1(b)/F1(c) 0.896 instead of 0.901.
+	 * morphing CPU time by ~20 % but gives F1(b)/F1(c) 0.896 instead of 0.901.
 	 * (INI morphMaxKeyframesPerBlock; serialized from version 2; Default: 0 = exact) */
 	unsigned maxKeyframesPerBlock{0};
 	/** Worker threads, 0 = all (Default: 0) */

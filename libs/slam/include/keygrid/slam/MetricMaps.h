@@ -27,10 +27,10 @@ struct MapFeedOptions
 	/** Input of the 2D ISM grid: "sparse" (the keyframe's map points, as in the paper) or
 	 * "dense" (its depth image) (Default: sparse) */
 	std::string ism2dInput{"sparse"};
-	/** Sparse 2D grid with estimateFloorFromDepth: the floor plane is re-estimated from the
-	 * map points of all keyframes so far (the floor is often out of view at the first one)
-	 * until it is found and at least this many keyframes contributed; the grid is rebuilt
-	 * when the floor changes (Default: 10) */
+	/** 2D grid with estimateFloorFromDepth: the floor plane is re-estimated from samples of the
+	 * depth images (map points where a keyframe has no depth) of all keyframes so far (the
+	 * floor is often out of view at the first one) until it is found and at least this many
+	 * keyframes contributed; the grid is rebuilt when the floor changes (Default: 10) */
 	int floorKeyframes{10};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
@@ -86,10 +86,11 @@ class MetricMaps
 	mrpt::maps::CMultiMetricMap m_maps;
 	MapFeedOptions m_feed;
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> m_insertedPoses;
-	/** Floor estimate of the sparse 2D grid: points of the first keyframes (world frame), how
-	 * many keyframes they came from, and the first keyframe's pose (its "down" is the hint). */
+	/** Floor estimate of the 2D grid: samples of the first keyframes (world frame), how
+	 * many keyframes they came from, and the first keyframe's pose (origin and heading of the floor frame). */
 	std::vector<mrpt::math::TPoint3D> m_floorPoints;
 	int m_floorKeyframes{0};
+	mrpt::math::TVector3D m_floorUpSum{0, 0, 0};  //!< sum of those keyframes' -y axes
 	std::optional<mrpt::poses::CPose3D> m_firstKeyframePose;
 };
 
