@@ -3,6 +3,7 @@
 #include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/system/filesystem.h>
 
+#include "SimSlamRun.h"
 #include "TestData.h"
 
 #include <fstream>
@@ -12,18 +13,12 @@ using namespace keygrid;
 
 TEST(LoopClosure, GeneratedRoomLoopIsClosed)
 {
-	const std::string dir = test::scratchDir("loop_room");
-	std::string out;
 	// The room loop compressed to 10 s (0.66 m/s, 38 deg/s): the camera returns to its start.
-	ASSERT_EQ(test::runCommand(test::toolPath("keygrid-sim") + " --quiet --frames 300 --scene " + test::sourceDir() +
-								   "/config/sim/room_loop.ini --output " + dir + "/seq", &out), 0) << out;
-	slam::SlamRunOptions o;
-	o.configPath = test::sourceDir() + "/config/sim.ini";
-	o.input = dir + "/seq/sequence.rawlog";
-	o.output = dir + "/out";
-	o.groundTruth = dir + "/seq/groundtruth.txt";
-	o.quiet = true;
-	const auto r = slam::runSlam(o);
+	const auto run = test::renderAndRunSlam(
+		test::scratchDir("loop_room"), "--frames 300 --scene " + test::sourceDir() + "/config/sim/room_loop.ini", true);
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	const auto& o = run.options;
+	const auto& r = run.result;
 	EXPECT_TRUE(r.error.empty()) << r.error;
 	EXPECT_EQ(r.tracked, 300u);
 	ASSERT_TRUE(r.ateRmse.has_value());

@@ -22,6 +22,7 @@
 #include <mrpt/system/CDirectoryExplorer.h>
 #include <mrpt/system/filesystem.h>
 
+#include "SimSlamRun.h"
 #include "TestData.h"
 
 #include <fstream>
@@ -42,20 +43,15 @@ constexpr std::size_t kFrames = 40;
 std::string runSlamOnShortSimSequence()
 {
 	const std::string dir = test::scratchDir(std::string("outputs_") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-	std::string log;
-	if (test::runCommand(test::toolPath("keygrid-sim") + " --quiet --scene " + test::dataDir() +
-							 "/sim/room_arc.ini --frames 40 --voxel-resolution 0 --floorplan-resolution 0 --output " + dir + "/seq",
-						 &log) != 0)
+	const auto run = test::renderAndRunSlam(
+		dir, "--scene " + test::dataDir() + "/sim/room_arc.ini --frames 40 --voxel-resolution 0 --floorplan-resolution 0", false);
+	if (!run.rendered)
 	{
-		ADD_FAILURE() << log;
+		ADD_FAILURE() << run.simLog;
 		return "";
 	}
-	slam::SlamRunOptions o;
-	o.configPath = test::sourceDir() + "/config/sim.ini";
-	o.input = dir + "/seq/sequence.rawlog";
-	o.output = dir + "/out";
-	o.quiet = true;
-	const auto r = slam::runSlam(o);
+	const auto& o = run.options;
+	const auto& r = run.result;
 	if (!r.error.empty() || r.frames != kFrames)
 	{
 		ADD_FAILURE() << "keygrid-slam: " << r.error << " (" << r.frames << " frames)";

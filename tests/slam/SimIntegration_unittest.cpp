@@ -10,23 +10,18 @@
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 
+#include "SimSlamRun.h"
 #include "TestData.h"
 
 using namespace keygrid;
 
 TEST(SimIntegration, ShippedSimConfigTracksAGeneratedSequenceWithMaps)
 {
-	const std::string dir = test::scratchDir("sim_integration");
-	std::string out;
-	ASSERT_EQ(test::runCommand(test::toolPath("keygrid-sim") + " --quiet --scene " + test::dataDir() +
-								   "/sim/room_arc.ini --output " + dir + "/seq", &out), 0) << out;
-	slam::SlamRunOptions o;
-	o.configPath = test::sourceDir() + "/config/sim.ini";
-	o.input = dir + "/seq/sequence.rawlog";
-	o.output = dir + "/out";
-	o.groundTruth = dir + "/seq/groundtruth.txt";
-	o.quiet = true;
-	const auto r = slam::runSlam(o);
+	const auto run = test::renderAndRunSlam(
+		test::scratchDir("sim_integration"), "--scene " + test::dataDir() + "/sim/room_arc.ini", true);
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	const auto& o = run.options;
+	const auto& r = run.result;
 	EXPECT_TRUE(r.error.empty()) << r.error;
 	EXPECT_EQ(r.frames, 90u);
 	EXPECT_EQ(r.tracked, 90u);
@@ -76,15 +71,11 @@ TEST(SimIntegration, ShippedSimConfigTracksAGeneratedSequenceWithMaps)
 TEST(SimIntegration, TwoDimensionalGridFindsTheFloorFromKeyframeDepth)
 {
 	const std::string dir = test::scratchDir("sim_integration_floor");
-	std::string out;
-	ASSERT_EQ(test::runCommand(test::toolPath("keygrid-sim") + " --quiet --scene " + test::dataDir() +
-								   "/sim/room_floor_view.ini --voxel-resolution 0 --output " + dir + "/seq", &out), 0) << out;
-	slam::SlamRunOptions o;
-	o.configPath = test::sourceDir() + "/config/sim.ini";
-	o.input = dir + "/seq/sequence.rawlog";
-	o.output = dir + "/out";
-	o.quiet = true;
-	const auto r = slam::runSlam(o);
+	const auto run = test::renderAndRunSlam(
+		dir, "--scene " + test::dataDir() + "/sim/room_floor_view.ini --voxel-resolution 0", false);
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	const auto& o = run.options;
+	const auto& r = run.result;
 	ASSERT_TRUE(r.error.empty()) << r.error;
 	EXPECT_EQ(r.tracked, 60u);
 	const auto grid = maps::TriStateGrid::loadRosMapServer(o.output + "/map_2d.yaml");

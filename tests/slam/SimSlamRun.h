@@ -1,0 +1,37 @@
+#pragma once
+/** \file SimSlamRun.h
+ * The integration tests' common step: keygrid-sim renders a scene into DIR/seq, and
+ * keygrid-slam runs the shipped config/sim.ini on its rawlog into DIR/out. */
+#include <keygrid/slam/apps/SlamApp.h>
+
+#include "TestData.h"
+
+#include <string>
+
+namespace keygrid::test
+{
+struct SimSlamRun
+{
+	bool rendered{false};      //!< keygrid-sim exited 0 (else nothing ran)
+	std::string simLog;        //!< keygrid-sim's output
+	slam::SlamRunOptions options;
+	slam::SlamRunResult result;
+};
+
+/** `simArgs` are keygrid-sim's arguments besides --quiet and --output (e.g. "--scene X.ini
+ * --frames 40"); `withGroundTruth` passes DIR/seq/groundtruth.txt as --gt. */
+inline SimSlamRun renderAndRunSlam(const std::string& dir, const std::string& simArgs, bool withGroundTruth)
+{
+	SimSlamRun run;
+	run.rendered =
+		runCommand(toolPath("keygrid-sim") + " --quiet " + simArgs + " --output " + dir + "/seq", &run.simLog) == 0;
+	if (!run.rendered) return run;
+	run.options.configPath = sourceDir() + "/config/sim.ini";
+	run.options.input = dir + "/seq/sequence.rawlog";
+	run.options.output = dir + "/out";
+	if (withGroundTruth) run.options.groundTruth = dir + "/seq/groundtruth.txt";
+	run.options.quiet = true;
+	run.result = slam::runSlam(run.options);
+	return run;
+}
+}  // namespace keygrid::test
