@@ -120,7 +120,8 @@ TEST(SlamApp, RealKinectRawlogFrameInitialisesTheMap)
 	slam::SlamRunOptions o;
 	o.configPath = test::sourceDir() + "/config/tum_fr1.ini";
 	o.input = rawlog;
-	o.output = test::scratchDir("slam_kinect");
+	// A nested output folder is created with its parents.
+	o.output = test::scratchDir("slam_kinect") + "/runs/today";
 	o.quiet = true;
 	const auto r = slam::runSlam(o);
 	EXPECT_TRUE(r.error.empty()) << r.error;

@@ -7,12 +7,55 @@
 
 namespace keygrid::sfm
 {
+namespace
+{
+/** Ceres wrapper of AnalyticReprojectionCost (3 residuals; q_cam_world[4], t_cam_world[3],
+ * p_world[3]). */
+class AnalyticBaCost final : public ceres::SizedCostFunction<3, 4, 3, 3>
+{
+   public:
+	explicit AnalyticBaCost(const AnalyticReprojectionCost& c) : m_cost(c) {}
+	bool Evaluate(double const* const* x, double* r, double** J) const override
+	{
+		return m_cost.evaluate(x[0], x[1], x[2], r, J ? J[0] : nullptr, J ? J[1] : nullptr, J ? J[2] : nullptr);
+	}
+
+   private:
+	AnalyticReprojectionCost m_cost;
+};
+
+/** Up to this many optimised keyframes the reduced camera system is solved densely. */
+constexpr std::size_t kAutoDenseMaxKeyFrames = 60;
+
+const char* solverName(BaLinearSolver s)
+{
+	switch (s)
+	{
+		case BaLinearSolver::DenseSchur: return "dense_schur";
+		case BaLinearSolver::SparseSchur: return "sparse_schur";
+		case BaLinearSolver::IterativeSchur: return "iterative_schur";
+		default: return "auto";
+	}
+}
+}  // namespace
+
 void BundleAdjusterOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
 	windowSize = c.read_int(s, "window_size", windowSize);
 	maxFixedKeyFrames = c.read_int(s, "max_fixed_keyframes", maxFixedKeyFrames);
 	iterations = c.read_int(s, "iterations", iterations);
 	threads = c.read_int(s, "threads", threads);
+	analyticJacobians = c.read_bool(s, "analytic_jacobians", analyticJacobians);
+	const std::string solver = c.read_string(s, "linear_solver", solverName(linearSolver));
+	bool known = false;
+	for (auto v : {BaLinearSolver::Auto, BaLinearSolver::DenseSchur, BaLinearSolver::SparseSchur, BaLinearSolver::IterativeSchur})
+		if (solver == solverName(v))
+		{
+			linearSolver = v;
+			known = true;
+		}
+	if (!known)
+		throw std::invalid_argument("[" + s + "] linear_solver = " + solver + " (must be auto, dense_schur, sparse_schur or iterative_schur)");
 	if (windowSize < 1) throw std::invalid_argument("[" + s + "] window_size = " + std::to_string(windowSize) + " (must be >= 1)");
 	if (iterations < 1) throw std::invalid_argument("[" + s + "] iterations = " + std::to_string(iterations) + " (must be >= 1)");
 	if (threads < 1) throw std::invalid_argument("[" + s + "] threads = " + std::to_string(threads) + " (must be >= 1)");
@@ -24,6 +67,8 @@ void BundleAdjusterOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, c
 	c.write(s, "max_fixed_keyframes", maxFixedKeyFrames, 30, 40, "fixed keyframes anchoring the window");
 	c.write(s, "iterations", iterations, 30, 40, "Levenberg-Marquardt iterations");
 	c.write(s, "threads", threads, 30, 40, "Ceres threads (1 = deterministic)");
+	c.write(s, "analytic_jacobians", analyticJacobians, 30, 40, "hand-written Jacobians (false: Ceres autodiff)");
+	c.write(s, "linear_solver", std::string(solverName(linearSolver)), 30, 40, "auto | dense_schur | sparse_schur | iterative_schur");
 }
 
 BundleAdjusterReport localBundleAdjustment(
@@ -69,23 +114,43 @@ BundleAdjusterReport bundleAdjust(
 			if (lm != kNoLandmark && map.hasLandmark(lm)) lms.insert(lm);
 
 	// --- Parameter blocks.
-	std::map<KeyFrameId, std::array<double, 7>> poses;  // q(x,y,z,w), t of T_cam_world
-	for (KeyFrameId id : local) toCeres(map.keyframe(id).T_world_cam, poses[id].data(), poses[id].data() + 4);
-	for (KeyFrameId id : fixedSet) toCeres(map.keyframe(id).T_world_cam, poses[id].data(), poses[id].data() + 4);
-	std::map<LandmarkId, std::array<double, 3>> points;
+	// Parameters live in two contiguous arrays in id order. Ceres orders the blocks of one
+	// elimination group by address, so this keeps the solve (and the trajectory) bit-identical
+	// from run to run.
+	std::map<KeyFrameId, std::size_t> poseIndex;  // keyframe -> row of poses
+	for (KeyFrameId id : local) poseIndex.emplace(id, 0);
+	for (KeyFrameId id : fixedSet) poseIndex.emplace(id, 0);
+	std::vector<std::array<double, 7>> poses(poseIndex.size());  // q(x,y,z,w), t of T_cam_world
+	std::size_t row = 0;
+	for (auto& [id, i] : poseIndex)
+	{
+		i = row++;
+		toCeres(map.keyframe(id).T_world_cam, poses[i].data(), poses[i].data() + 4);
+	}
+	std::vector<std::array<double, 3>> points;  // in the order of lms
+	points.reserve(lms.size());
 	for (LandmarkId lm : lms)
 	{
 		const auto& p = map.landmark(lm).p_world;
-		points[lm] = {p.x(), p.y(), p.z()};
+		points.push_back({p.x(), p.y(), p.z()});
 	}
 
 	ceres::Problem::Options po;
 	po.manifold_ownership = ceres::TAKE_OWNERSHIP;
+	// One robust loss per kind of observation, shared by all residual blocks.
+	po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+	ceres::HuberLoss lossMono(std::sqrt(o.chi2Mono)), lossRgbd(std::sqrt(o.chi2Rgbd));
 	ceres::Problem problem(po);
-	for (auto& [id, pq] : poses)
+	// Schur ordering given explicitly (landmarks eliminated first, then poses), which spares
+	// Ceres the independent-set search over the problem graph.
+	auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+	for (const auto& [id, i] : poseIndex)
 	{
+		auto& pq = poses[i];
 		problem.AddParameterBlock(pq.data(), 4, new ceres::EigenQuaternionManifold());
 		problem.AddParameterBlock(pq.data() + 4, 3);
+		ordering->AddElementToGroup(pq.data(), 1);
+		ordering->AddElementToGroup(pq.data() + 4, 1);
 		// Gauge: keyframe 0 defines the world frame and never moves; fixed observers anchor
 		// the window to the rest of the map.
 		if (fixedSet.count(id) || id == map.keyframes().begin()->first)
@@ -102,25 +167,32 @@ BundleAdjusterReport bundleAdjust(
 		ceres::ResidualBlockId block;
 	};
 	std::vector<Obs> all;
-	for (LandmarkId lm : lms)
+	std::size_t lmRow = 0;
+	for (auto lmIt = lms.begin(); lmIt != lms.end(); ++lmIt, ++lmRow)
 	{
+		const LandmarkId lm = *lmIt;
+		double* point = points[lmRow].data();
 		for (const auto& [kf, kp] : map.landmark(lm).observations)
 		{
-			if (!poses.count(kf)) continue;
+			const auto pi = poseIndex.find(kf);
+			if (pi == poseIndex.end()) continue;
 			const auto& f = map.keyframe(kf).features;
 			const Eigen::Vector2d uv(f.undistorted[kp].x, f.undistorted[kp].y);
 			const double invSigma = 1.0 / f.levelScale[f.keypoints[kp].octave];
 			const double d = f.depth[kp];
 			const bool rgbd = d > 0 && d < o.maxDepthForRgbd;
-			ceres::CostFunction* cost =
-				rgbd ? static_cast<ceres::CostFunction*>(new ceres::AutoDiffCostFunction<RgbdReprojectionCost, 3, 4, 3, 3>(
-						   new RgbdReprojectionCost(uv, d, o.bf, invSigma, K)))
-					 : new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3>(
-						   new MonoReprojectionCost(uv, invSigma, K));
-			auto& pq = poses[kf];
+			ceres::CostFunction* cost = nullptr;
+			if (o.analyticJacobians) cost = new AnalyticBaCost(AnalyticReprojectionCost(uv, rgbd ? d : 0.0, o.bf, invSigma, K));
+			else if (rgbd)
+				cost = new ceres::AutoDiffCostFunction<RgbdReprojectionCost, 3, 4, 3, 3>(
+					new RgbdReprojectionCost(uv, d, o.bf, invSigma, K));
+			else
+				cost = new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3>(new MonoReprojectionCost(uv, invSigma, K));
+			auto& pq = poses[pi->second];
 			const auto block = problem.AddResidualBlock(
-				cost, new ceres::HuberLoss(std::sqrt(rgbd ? o.chi2Rgbd : o.chi2Mono)), pq.data(), pq.data() + 4,
-				points[lm].data());
+				cost, rgbd ? &lossRgbd : &lossMono, pq.data(), pq.data() + 4,
+				point);
+			if (all.empty() || all.back().lm != lm) ordering->AddElementToGroup(point, 0);
 			all.push_back({lm, kf, rgbd, block});
 		}
 	}
@@ -131,8 +203,21 @@ BundleAdjusterReport bundleAdjust(
 	if (all.empty()) return rep;
 
 	ceres::Solver::Options so;
-	so.linear_solver_type = ceres::SPARSE_SCHUR;
+	switch (o.linearSolver)
+	{
+		case BaLinearSolver::DenseSchur: so.linear_solver_type = ceres::DENSE_SCHUR; break;
+		case BaLinearSolver::SparseSchur: so.linear_solver_type = ceres::SPARSE_SCHUR; break;
+		case BaLinearSolver::IterativeSchur:
+			so.linear_solver_type = ceres::ITERATIVE_SCHUR;
+			so.preconditioner_type = ceres::SCHUR_JACOBI;
+			break;
+		default:
+			// The reduced camera system has 6 unknowns per moving keyframe: dense Cholesky is the
+			// fastest for local windows, sparse for large (global) problems.
+			so.linear_solver_type = local.size() <= kAutoDenseMaxKeyFrames ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
+	}
 	so.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
+	so.linear_solver_ordering = ordering;
 	so.max_num_iterations = o.iterations;
 	so.num_threads = o.threads;
 	so.logging_type = ceres::SILENT;
@@ -142,8 +227,17 @@ BundleAdjusterReport bundleAdjust(
 	rep.finalCost = summary.final_cost;
 
 	// --- Write back, then drop observations that remain outliers (plain chi-square).
-	for (KeyFrameId id : local) map.keyframe(id).T_world_cam = fromCeres(poses[id].data(), poses[id].data() + 4);
-	for (LandmarkId lm : lms) map.landmark(lm).p_world = Eigen::Vector3d(points[lm][0], points[lm][1], points[lm][2]);
+	for (KeyFrameId id : local)
+	{
+		const auto& pq = poses[poseIndex.at(id)];
+		map.keyframe(id).T_world_cam = fromCeres(pq.data(), pq.data() + 4);
+	}
+	lmRow = 0;
+	for (LandmarkId lm : lms)
+	{
+		const auto& p = points[lmRow++];
+		map.landmark(lm).p_world = Eigen::Vector3d(p[0], p[1], p[2]);
+	}
 	for (const auto& ob : all)
 	{
 		double cost = 0;

@@ -67,7 +67,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		// have moved tens of pixels: match descriptors against the reference keyframe first.
 		if (!m_velocity)
 		{
-			ok = trackByPnp(cur, m_refKf, m_opts.minInliers);
+			ok = trackByPnp(cur, m_refKf, m_opts.minInliers / 2);
 			out.method = "pnp";
 		}
 		if (!ok)
@@ -81,7 +81,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		{
 			cur.matches.assign(cur.features.size(), kNoLandmark);
 			cur.T_world_cam = m_lastPose;
-			ok = trackByPnp(cur, m_refKf, m_opts.minInliers);
+			ok = trackByPnp(cur, m_refKf, m_opts.minInliers / 2);
 			out.method = "pnp";
 		}
 	}
@@ -95,6 +95,15 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		updateLocalKeyFrames(cur);
 		cur.inliers = trackLocalMap(cur, m_opts.radiusLocalMap);
 		ok = cur.inliers >= m_opts.minInliers;
+		// A look-alike place matches a few dozen landmarks of a local map that shows hundreds
+		// in view; the true place matches a good share of them.
+		if (ok && out.method == "relocalization")
+			ok = cur.inliers >= m_opts.relocalizationMinInlierRatio * cur.localMapInView;
+		if (ok && out.method == "relocalization")
+		{
+			out.relocalizationKeyFrame = m_refKf;
+			out.relocalizedByPlaceRecognition = m_relocRecognized;
+		}
 	}
 
 	out.matches = static_cast<int>(std::count_if(cur.matches.begin(), cur.matches.end(), [](LandmarkId l) { return l != kNoLandmark; }));
@@ -246,7 +255,7 @@ bool Tracker::trackByPrediction(Current& cur)
 	return refinePose(cur) >= m_opts.minInliers / 2;
 }
 
-bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minInliers)
+bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minRefinedInliers)
 {
 	if (!m_map.hasKeyFrame(kfId)) return false;
 	const auto& kf = m_map.keyframe(kfId);
@@ -268,7 +277,7 @@ bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minInliers)
 	cur.matches.assign(cur.features.size(), kNoLandmark);
 	for (int k : res.inliers) cur.matches[link[k].first] = link[k].second;
 	const int inl = refinePose(cur);
-	if (inl < minInliers / 2) return false;
+	if (inl < minRefinedInliers) return false;
 	m_localKfs = {kfId};
 	for (KeyFrameId n : m_map.bestCovisibles(kfId, 10)) m_localKfs.push_back(n);
 	return true;
@@ -276,17 +285,26 @@ bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minInliers)
 
 bool Tracker::relocalize(Current& cur)
 {
-	// Newest keyframes first: after a short loss the camera is usually near where it was.
+	// Place recognition first (any keyframe of the map, however old), then the newest
+	// keyframes: after a short loss the camera is usually near where it was.
 	std::vector<KeyFrameId> ids;
-	for (auto it = m_map.keyframes().rbegin(); it != m_map.keyframes().rend() && static_cast<int>(ids.size()) < m_opts.relocalizationCandidates; ++it)
-		ids.push_back(it->first);
+	if (m_placeRecognizer && m_opts.relocalizationBowCandidates > 0)
+		ids = m_placeRecognizer(cur.features, m_opts.relocalizationBowCandidates);
+	const std::set<KeyFrameId> recognized(ids.begin(), ids.end());
+	int newest = 0;
+	for (auto it = m_map.keyframes().rbegin(); it != m_map.keyframes().rend() && newest < m_opts.relocalizationCandidates; ++it, ++newest)
+		if (!recognized.count(it->first)) ids.push_back(it->first);
 	for (KeyFrameId id : ids)
 	{
+		if (!m_map.hasKeyFrame(id)) continue;
 		cur.matches.assign(cur.features.size(), kNoLandmark);
 		cur.T_world_cam = m_map.keyframe(id).T_world_cam;
-		if (trackByPnp(cur, id, m_opts.minInliers * 2))
+		// A look-alike place (repeated texture) can give a few dozen consistent matches; a
+		// true revisit gives hundreds, so relocalization asks for twice the tracking minimum.
+		if (trackByPnp(cur, id, 2 * m_opts.minInliers))
 		{
 			m_refKf = id;
+			m_relocRecognized = recognized.count(id) > 0;
 			return true;
 		}
 	}
@@ -329,6 +347,7 @@ int Tracker::trackLocalMap(Current& cur, float radius)
 	cur.matchedBeforeLocalMap = cur.matches;
 	cur.hocExcluded.clear();
 	auto cands = projectLocalLandmarks(cur, true);
+	cur.localMapInView = static_cast<int>(cands.size() + std::count_if(cur.matches.begin(), cur.matches.end(), [](LandmarkId l) { return l != kNoLandmark; }));
 	searchByProjection(cur.features, cands, radius, m_opts.matcher, cur.matches);
 	if (m_hoc) cur.hocVisible = cands;
 	const int inl = refinePose(cur);

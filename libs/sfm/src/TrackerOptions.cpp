@@ -23,6 +23,8 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	minInliers = c.read_int(s, "min_inliers", minInliers);
 	localKeyFrames = c.read_int(s, "local_keyframes", localKeyFrames);
 	relocalizationCandidates = c.read_int(s, "relocalization_candidates", relocalizationCandidates);
+	relocalizationBowCandidates = c.read_int(s, "relocalization_bow_candidates", relocalizationBowCandidates);
+	relocalizationMinInlierRatio = c.read_double(s, "relocalization_min_inlier_ratio", relocalizationMinInlierRatio);
 	maxFramesBetweenKeyFrames = c.read_int(s, "max_frames_between_keyframes", maxFramesBetweenKeyFrames);
 	keyFrameTrackedRatio = c.read_double(s, "keyframe_tracked_ratio", keyFrameTrackedRatio);
 	keyFrameRefMinObservations = c.read_int(s, "keyframe_ref_min_observations", keyFrameRefMinObservations);
@@ -48,6 +50,10 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	positive(s, "keyframe_ref_min_observations", keyFrameRefMinObservations);
 	positive(s, "pose_rounds", pose.rounds);
 	positive(s, "pose_iterations", pose.iterationsPerRound);
+	if (relocalizationCandidates < 0 || relocalizationBowCandidates < 0)
+		throw std::invalid_argument("[" + s + "] relocalization_candidates / relocalization_bow_candidates must be >= 0");
+	if (!(relocalizationMinInlierRatio >= 0 && relocalizationMinInlierRatio <= 1))
+		throw std::invalid_argument("[" + s + "] relocalization_min_inlier_ratio = " + std::to_string(relocalizationMinInlierRatio) + " (must be in [0, 1])");
 	if (!(keyFrameTrackedRatio > 0 && keyFrameTrackedRatio <= 1))
 		throw std::invalid_argument("[" + s + "] keyframe_tracked_ratio = " + std::to_string(keyFrameTrackedRatio) + " (must be in (0, 1])");
 	if (!(matcher.ratio > 0 && matcher.ratio <= 1))
@@ -62,7 +68,9 @@ void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "min_matches_prediction", minMatchesPrediction, 34, 40, "below: wider search, then PnP fallback");
 	c.write(s, "min_inliers", minInliers, 34, 40, "inliers to call a frame tracked");
 	c.write(s, "local_keyframes", localKeyFrames, 34, 40, "keyframes forming the local map");
-	c.write(s, "relocalization_candidates", relocalizationCandidates, 34, 40, "keyframes tried when lost");
+	c.write(s, "relocalization_candidates", relocalizationCandidates, 34, 40, "newest keyframes tried when lost");
+	c.write(s, "relocalization_bow_candidates", relocalizationBowCandidates, 34, 40, "vocabulary-tree candidates tried first when lost");
+	c.write(s, "relocalization_min_inlier_ratio", relocalizationMinInlierRatio, 34, 40, "share of the local map in view a relocalization must match");
 	c.write(s, "max_frames_between_keyframes", maxFramesBetweenKeyFrames, 34, 40, "");
 	c.write(s, "keyframe_tracked_ratio", keyFrameTrackedRatio, 34, 40, "new keyframe below this share of the reference's landmarks");
 	c.write(s, "keyframe_ref_min_observations", keyFrameRefMinObservations, 34, 40, "reference landmarks counted: seen by >= this many keyframes");

@@ -1,4 +1,5 @@
 #include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/DataFiles.h>
 #include <keygrid/slam/LoopCloser.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/CMatrixFixed.h>
@@ -38,6 +39,7 @@ void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 {
 	enabled = c.read_bool(s, "enabled", enabled);
 	vocabulary = c.read_string(s, "vocabulary", vocabulary);
+	if (vocabulary.empty()) throw std::invalid_argument("[" + s + "] vocabulary is empty (default, train, or a file)");
 	trainKeyFrames = c.read_int(s, "train_keyframes", trainKeyFrames);
 	minKeyFrameGap = c.read_int(s, "min_keyframe_gap", minKeyFrameGap);
 	consistency = c.read_int(s, "consistency", consistency);
@@ -62,10 +64,10 @@ void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 void LoopClosingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
 	c.write(s, "enabled", enabled, 30, 40, "detect and correct loops");
-	c.write(s, "vocabulary", vocabulary.empty() ? std::string("train") : vocabulary, 30, 40, "vocabulary file, or train (from the first keyframes)");
+	c.write(s, "vocabulary", vocabulary, 30, 40, "default (shipped, ORB), train (first keyframes), or a file");
 	c.write(s, "train_keyframes", trainKeyFrames, 30, 40, "keyframes that train the vocabulary");
-	c.write(s, "vocabulary_branching", vocabularyOptions.branching, 30, 40, "");
-	c.write(s, "vocabulary_levels", vocabularyOptions.levels, 30, 40, "");
+	c.write(s, "vocabulary_branching", vocabularyOptions.branching, 30, 40, "k of the in-run (train) vocabulary");
+	c.write(s, "vocabulary_levels", vocabularyOptions.levels, 30, 40, "L of the in-run (train) vocabulary");
 	c.write(s, "min_keyframe_gap", minKeyFrameGap, 30, 40, "candidates at least this many keyframes older");
 	c.write(s, "consistency", consistency, 30, 40, "consecutive keyframes agreeing on a candidate");
 	c.write(s, "min_inliers", ransac.minInliers, 30, 40, "3D-3D RANSAC inliers to accept a loop");
@@ -76,10 +78,27 @@ void LoopClosingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, cons
 	c.write(s, "max_correction_deg", maxCorrectionDeg, 30, 40, "[deg] largest loop rotation correction");
 }
 
-LoopCloser::LoopCloser(sfm::SparseMap& map, sfm::LocalMapper& mapper, const LoopClosingOptions& opts, const sfm::MatcherOptions& matcher)
+LoopCloser::LoopCloser(
+	sfm::SparseMap& map, sfm::LocalMapper& mapper, const LoopClosingOptions& opts, const sfm::MatcherOptions& matcher,
+	const std::string& featureType)
 	: m_map(map), m_mapper(mapper), m_opts(opts), m_matcher(matcher), m_consistency(opts.consistency)
 {
-	if (!opts.vocabulary.empty() && opts.vocabulary != "train") m_vocab = loop::Vocabulary::load(opts.vocabulary);
+	// The shipped vocabulary was trained on ORB descriptors (scripts/make-default-vocabulary.sh);
+	// SIFT runs train their own in the run.
+	if (opts.vocabulary == "train" || (opts.vocabulary == "default" && featureType != "orb")) return;
+	m_vocabFile = opts.vocabulary == "default" ? findDataFile("vocabulary/keygrid_orb_k10_L4.bin") : opts.vocabulary;
+	m_vocab = loop::Vocabulary::load(m_vocabFile);
+	const bool binary = m_vocab.descriptorType() == loop::DescriptorType::Binary;
+	if (binary != (featureType == "orb"))
+		throw std::invalid_argument(
+			"vocabulary '" + m_vocabFile + "' holds " + (binary ? "binary (ORB)" : "float (SIFT)") + " descriptors, but [features] type = " + featureType);
+}
+
+std::string LoopCloser::vocabularySource() const
+{
+	if (!m_vocabFile.empty()) return m_vocabFile;
+	if (m_vocab.empty()) return "not trained yet (needs " + std::to_string(m_opts.trainKeyFrames) + " keyframes)";
+	return "trained in the run on " + std::to_string(m_vocab.trainingImages()) + " keyframes";
 }
 
 void LoopCloser::trainIfReady()
@@ -93,6 +112,17 @@ void LoopCloser::trainIfReady()
 		m_db.add(id, m_vocab.transform(kf.features.descriptors));
 		m_dbIds.insert(id);
 	}
+}
+
+std::vector<sfm::KeyFrameId> LoopCloser::placeCandidates(const cv::Mat& descriptors, int maxCandidates) const
+{
+	std::vector<sfm::KeyFrameId> out;
+	if (m_vocab.empty() || maxCandidates <= 0 || descriptors.empty()) return out;
+	loop::DatabaseQuery q;
+	q.maxResults = static_cast<std::size_t>(maxCandidates);
+	for (const auto& c : m_db.query(m_vocab.transform(descriptors), q))
+		if (m_map.hasKeyFrame(c.id)) out.push_back(c.id);
+	return out;
 }
 
 std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const loop::BowVector& bow, double& score)
@@ -273,6 +303,10 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 				if (!ev.newPoses.empty())
 				{
 					ev.frameIndex = frameIndex;
+					ev.keyframeTimestamp = m_map.keyframe(kf).timestamp;
+					ev.loopKeyFrameTimestamp = m_map.keyframe(*cand).timestamp;
+					ev.measuredDistance = T_cand_cur.translation().norm();
+					ev.measuredAngleDeg = Eigen::AngleAxisd(T_cand_cur.linear()).angle() * 180.0 / M_PI;
 					ev.score = score;
 					ev.inliers = inliers;
 					ev.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

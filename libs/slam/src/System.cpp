@@ -18,7 +18,12 @@ System::System(const SlamConfig& cfg)
 	  m_tracker(m_map, cfg.tracker),
 	  m_mapper(m_map, cfg.mapping, cfg.tracker.matcher)
 {
-	if (cfg.loop.enabled) m_loopCloser = std::make_unique<LoopCloser>(m_map, m_mapper, cfg.loop, cfg.tracker.matcher);
+	if (cfg.loop.enabled)
+	{
+		m_loopCloser = std::make_unique<LoopCloser>(m_map, m_mapper, cfg.loop, cfg.tracker.matcher, cfg.features.type);
+		// Relocalization asks the loop closer's keyframe database (vocabulary tree) first.
+		m_tracker.setPlaceRecognizer([this](const sfm::FrameFeatures& f, int n) { return m_loopCloser->placeCandidates(f.descriptors, n); });
+	}
 }
 
 sfm::FrameFeatures System::extract(const core::Frame& frame) const { return m_extractor.extract(frame); }

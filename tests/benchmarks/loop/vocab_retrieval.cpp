@@ -4,12 +4,16 @@
  *   self      - the sequence's own 250 frames (a pre-pass over the input),
  *   self/10   - every 10th frame of the sequence (a quick pre-pass),
  *   procedural- 100 views of a generated texture (shapes), nothing real,
- *   other     - the other real frames we have (fr1_desk 9 + ICL living room 5).
+ *   other     - the other real frames we have (fr1_desk 9 + ICL living room 5),
+ *   self/5 L3, self/5 L4 - every 5th frame (keygrid-vocab train --every 5), k = 10, depth 3 / 4,
+ *   first10 L3 - frames 0, 5, ..., 45 with k = 10, L = 3 (like keygrid-slam's in-run training),
+ *   NAME=FILE - vocabularies given on the command line (e.g. the shipped default).
  * Database: frames 0, 10, 20, ...; queries: frames 5, 15, 25, ... A database frame shows the same
  * place as the query when (ground truth) their optical axes differ by < 15 deg and centres by
  * < 0.3 m. "revisit" ignores database frames within 1 s of the query, so only returns to an
- * earlier view count. Prints recall@1 (top candidate is a same-place frame) per vocabulary.
- * Run: <build>/bin/keygrid_vocab_retrieval [SHARED_DATA_DIR]
+ * earlier view count. Prints recall@1 (top candidate is a same-place frame) per vocabulary and,
+ * over the revisit queries, the median of (best same-place score / best other-place score).
+ * Run: <build>/bin/keygrid_vocab_retrieval [SHARED_DATA_DIR] [NAME=FILE.bin ...]
  */
 #include <keygrid/core/FrameSource.h>
 #include <keygrid/core/TumTrajectory.h>
@@ -18,6 +22,7 @@
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -104,6 +109,7 @@ void evaluate(const std::string& name, const loop::Vocabulary& v, const Seq& s, 
 	for (const auto& d : s.desc) bows.push_back(v.transform(d));
 	for (std::size_t i = 0; i < s.desc.size(); i += 10) db.add(i, bows[i]);
 	int queries = 0, correct = 0, revisitQueries = 0, revisitCorrect = 0;
+	std::vector<double> margins;
 	for (std::size_t q = 5; q < s.desc.size(); q += 10)
 	{
 		bool any = false, anyFar = false;
@@ -128,18 +134,30 @@ void evaluate(const std::string& name, const loop::Vocabulary& v, const Seq& s, 
 			++revisitQueries;
 			const auto r = db.query(bows[q], opt);
 			revisitCorrect += !r.empty() && samePlace(s.pose[q], s.pose[r[0].id]);
+			// Margin: best same-place score over best other-place score (> 1: separable).
+			double same = 0, other = 0;
+			for (std::size_t d = 0; d < s.desc.size(); d += 10)
+			{
+				if (opt.exclude.count(d)) continue;
+				double& best = samePlace(s.pose[q], s.pose[d]) ? same : other;
+				best = std::max(best, v.score(bows[q], bows[d]));
+			}
+			margins.push_back(same / std::max(other, 1e-9));
 		}
 	}
+	std::sort(margins.begin(), margins.end());
+	const double medianMargin = margins.empty() ? 0.0 : margins[margins.size() / 2];
 	std::printf(
-		"| %-10s | %6zu | %5zu | %5.1f | %2d/%2d (%3.0f %%) | %2d/%2d (%3.0f %%) |\n", name.c_str(), v.trainingImages(),
+		"| %-10s | %6zu | %5zu | %5.1f | %2d/%2d (%3.0f %%) | %2d/%2d (%3.0f %%) | %5.2f |\n", name.c_str(), v.trainingImages(),
 		v.numWords(), trainSeconds, correct, queries, 100.0 * correct / std::max(1, queries), revisitCorrect, revisitQueries,
-		100.0 * revisitCorrect / std::max(1, revisitQueries));
+		100.0 * revisitCorrect / std::max(1, revisitQueries), medianMargin);
 }
 
-loop::Vocabulary timedTrain(const std::vector<cv::Mat>& d, double& seconds)
+loop::Vocabulary timedTrain(const std::vector<cv::Mat>& d, double& seconds, int levels = 4)
 {
 	const auto t0 = std::chrono::steady_clock::now();
-	loop::VocabularyOptions o;  // k = 10, L = 4
+	loop::VocabularyOptions o;  // k = 10, L = 4 unless told
+	o.levels = levels;
 	auto v = loop::Vocabulary::train(d, o);
 	seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	return v;
@@ -148,7 +166,7 @@ loop::Vocabulary timedTrain(const std::vector<cv::Mat>& d, double& seconds)
 
 int main(int argc, char** argv)
 {
-	const std::string data = argc > 1 ? argv[1] : KEYGRID_SHARED_DATA_DIR;
+	const std::string data = argc > 1 && std::string(argv[1]).find('=') == std::string::npos ? argv[1] : KEYGRID_SHARED_DATA_DIR;
 	const std::string rpy = data + "/tum_fr1_rpy_first250";
 	if (!std::filesystem::is_directory(rpy))
 	{
@@ -162,7 +180,7 @@ int main(int argc, char** argv)
 	for (std::size_t i = 0; i < s.desc.size(); i += 10) sub.push_back(s.desc[i]);
 
 	std::printf("fr1_rpy: %zu frames, database every 10th, queries at +5\n", s.desc.size());
-	std::printf("| vocabulary | images | words | train [s] | recall@1 | revisit recall@1 |\n|---|---|---|---|---|---|\n");
+	std::printf("| vocabulary | images | words | train [s] | recall@1 | revisit recall@1 | median margin |\n|---|---|---|---|---|---|---|\n");
 	double sec = 0;
 	{
 		const auto v = timedTrain(s.desc, sec);
@@ -179,6 +197,27 @@ int main(int argc, char** argv)
 	{
 		const auto v = timedTrain(other, sec);
 		evaluate("other", v, s, sec);
+	}
+	std::vector<cv::Mat> sub5;
+	for (std::size_t i = 0; i < s.desc.size(); i += 5) sub5.push_back(s.desc[i]);
+	for (int levels : {3, 4})
+	{
+		const auto v = timedTrain(sub5, sec, levels);
+		evaluate("self/5 L" + std::to_string(levels), v, s, sec);
+	}
+	{
+		// What keygrid-slam's in-run default sees: 10 early frames (keyframes come every few
+		// frames), k = 10, L = 3.
+		std::vector<cv::Mat> first(sub5.begin(), sub5.begin() + std::min<std::size_t>(10, sub5.size()));
+		const auto v = timedTrain(first, sec, 3);
+		evaluate("first10 L3", v, s, sec);
+	}
+	for (int i = 1; i < argc; ++i)
+	{
+		const std::string a = argv[i];
+		const auto eq = a.find('=');
+		if (eq == std::string::npos) continue;
+		evaluate(a.substr(0, eq), loop::Vocabulary::load(a.substr(eq + 1)), s, 0.0);
 	}
 	return 0;
 }

@@ -20,6 +20,7 @@
 
 #include <chrono>
 #include <csignal>
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 #include <sstream>
@@ -71,8 +72,13 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (o.cameraOverride) cfg.camera = *o.cameraOverride;
 	if (cfg.mode != "sequential" && cfg.mode != "threaded")
 		throw std::invalid_argument("mode '" + cfg.mode + "' (expected sequential or threaded)");
-	if (!mrpt::system::directoryExists(o.output) && !mrpt::system::createDirectory(o.output))
-		throw std::runtime_error("cannot create output folder '" + o.output + "'");
+	{
+		// Parents too (--output runs/today/seq1); a file in the way is named.
+		std::error_code ec;
+		std::filesystem::create_directories(o.output, ec);
+		if (ec || !mrpt::system::directoryExists(o.output))
+			throw std::runtime_error("cannot create output folder '" + o.output + "'" + (ec ? ": " + ec.message() : std::string()));
+	}
 	core::FrameSourceOptions so;
 	if (!cfg.camera.empty() && cfg.camera != "auto") so.camera = core::RgbdCamera::FromPresetOrFile(cfg.camera);
 	// Files: decoding runs ahead on its own thread in both modes; frames keep their order.
@@ -299,6 +305,18 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "  \"tracked\": " << st.tracked << ",\n";
 	js << "  \"lost\": " << st.lost << ",\n";
 	js << "  \"relocalizations\": " << st.relocalizations << ",\n";
+	js << "  \"relocalization_events\": [";
+	{
+		const char* sep = "";
+		for (const auto& f : sys.frames())
+			if (f.tracked && f.method == "relocalization")
+			{
+				js << sep << "{\"frame\": " << f.index << ", \"keyframe\": " << f.relocalizationKeyFrame
+				   << ", \"place_recognition\": " << (f.relocalizedByPlaceRecognition ? "true" : "false") << "}";
+				sep = ", ";
+			}
+	}
+	js << "],\n";
 	js << "  \"pnp_fallbacks\": " << st.pnpFallbacks << ",\n";
 	js << "  \"skipped_input_entries\": " << skipped << ",\n";
 	if (!lastSkip.empty()) js << "  \"last_skip_reason\": \"" << jsonEscape(lastSkip) << "\",\n";
@@ -313,13 +331,17 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (cfg.tracker.hoc.enabled)
 		js << "  \"hoc\": {\"landmarks_pruned\": " << st.landmarksPrunedHoc << ", \"increments\": " << st.hocIncrements
 		   << ", \"decrements\": " << st.hocDecrements << ", \"occluded\": " << st.hocOccluded << ", \"recovered\": " << st.hocRecovered << "},\n";
+	if (sys.loopCloser()) js << "  \"vocabulary\": \"" << jsonEscape(sys.loopCloser()->vocabularySource()) << "\",\n";
 	js << "  \"loop_closures\": [";
 	for (std::size_t i = 0; i < sys.loopClosures().size(); i++)
 	{
 		const auto& ev = sys.loopClosures()[i];
-		char l[256];
-		std::snprintf(l, sizeof(l), "%s{\"frame\": %zu, \"keyframe\": %llu, \"loop_keyframe\": %llu, \"score\": %.4f, \"inliers\": %d, \"correction_m\": %.4f, \"seconds\": %.4f}",
-					  i ? ", " : "", ev.frameIndex, static_cast<unsigned long long>(ev.keyframe), static_cast<unsigned long long>(ev.loopKeyFrame), ev.score, ev.inliers, ev.correctionMetres, ev.seconds);
+		char l[512];
+		std::snprintf(l, sizeof(l),
+					  "%s{\"frame\": %zu, \"keyframe\": %llu, \"loop_keyframe\": %llu, \"keyframe_timestamp\": %.6f, \"loop_keyframe_timestamp\": %.6f, "
+					  "\"score\": %.4f, \"inliers\": %d, \"measured_distance_m\": %.4f, \"measured_angle_deg\": %.3f, \"correction_m\": %.4f, \"seconds\": %.4f}",
+					  i ? ", " : "", ev.frameIndex, static_cast<unsigned long long>(ev.keyframe), static_cast<unsigned long long>(ev.loopKeyFrame),
+					  ev.keyframeTimestamp, ev.loopKeyFrameTimestamp, ev.score, ev.inliers, ev.measuredDistance, ev.measuredAngleDeg, ev.correctionMetres, ev.seconds);
 		js << l;
 	}
 	js << "],\n";

@@ -2,7 +2,8 @@
 /** \file LocalBundleAdjuster.h
  * Local bundle adjustment around a keyframe: the keyframe and its covisible neighbours and all
  * landmarks they see are optimised; keyframes that also see those landmarks stay fixed.
- * Ceres, Huber loss, Schur complement with SuiteSparse when available.
+ * Ceres, Huber loss, analytic Jacobians, Schur complement (dense for local windows, SuiteSparse
+ * for large problems).
  */
 #include <keygrid/sfm/PoseOptimizer.h>
 #include <keygrid/sfm/SparseMap.h>
@@ -18,6 +19,19 @@ class CConfigFileBase;
 
 namespace keygrid::sfm
 {
+/** Linear solver of the Levenberg-Marquardt steps (all eliminate the landmarks first). */
+enum class BaLinearSolver
+{
+	/** DenseSchur up to 60 optimised keyframes, SparseSchur above */
+	Auto,
+	/** Dense Cholesky of the reduced camera system */
+	DenseSchur,
+	/** SuiteSparse Cholesky of the reduced camera system */
+	SparseSchur,
+	/** Conjugate gradients on the reduced system, Schur-Jacobi preconditioner */
+	IterativeSchur
+};
+
 struct BundleAdjusterOptions
 {
 	/** Covisible keyframes optimised with the current one (Default: 10) */
@@ -34,6 +48,12 @@ struct BundleAdjusterOptions
 	double maxDepthForRgbd{6.0};
 	/** Threads used by Ceres (Default: 1; results are then deterministic) */
 	int threads{1};
+	/** Hand-written Jacobians (AnalyticReprojectionCost); false: Ceres autodiff of the
+	 * templated costs (Default: true) */
+	bool analyticJacobians{true};
+	/** Linear solver, INI `linear_solver` = auto | dense_schur | sparse_schur |
+	 * iterative_schur (Default: auto) */
+	BaLinearSolver linearSolver{BaLinearSolver::Auto};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;

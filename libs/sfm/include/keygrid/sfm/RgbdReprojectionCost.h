@@ -90,6 +90,91 @@ struct RgbdReprojectionCost
 	PinholeIntrinsics m_K;
 };
 
+/** Reprojection residuals with hand-written Jacobians, for bundle adjustment (same model and
+ * parameters as RgbdReprojectionCost / MonoReprojectionCost). Always 3 residuals: without
+ * depth the third one is identically 0 (zero Jacobian row), so every residual block of a BA
+ * problem has the same shape (3 residuals; q: 3 tangent dims, t: 3, p: 3) and Ceres can use
+ * its fixed-size Schur eliminator.
+ *
+ * With q = (v, w) (v = x,y,z), Eigen evaluates q * p = p + 2w (v x p) + 2 v x (v x p); the
+ * Jacobians below are those of this polynomial (exact also for a not quite unit q, like
+ * autodiff of the templated costs):
+ *   d pc / dw = 2 (v x p)
+ *   d pc / dv = -2w [p]x + 2 ((v.p) I + v p^T - 2 p v^T)
+ *   d pc / dp = I + 2w [v]x + 2 [v]x^2   (= R(q) for a unit q)
+ *   d pc / dt = I
+ * and with (x, y, z) = pc, e = -invSigma:
+ *   d r0 / d pc = e (fx / z, 0, -fx x / z^2)
+ *   d r1 / d pc = e (0, fy / z, -fy y / z^2)
+ *   d r2 / d pc = d r0 / d pc + e (0, 0, bf / z^2)     (only with depth)
+ */
+struct AnalyticReprojectionCost
+{
+	/** Observation with depth (3 residuals); `depth` <= 0 gives a mono one (third residual 0). */
+	AnalyticReprojectionCost(
+		const Eigen::Vector2d& uv, double depth, double bf, double invSigma, const PinholeIntrinsics& K)
+		: m_uv(uv), m_ur(depth > 0 ? uv.x() - bf / depth : 0.0), m_bf(bf), m_invSigma(invSigma), m_rgbd(depth > 0), m_K(K)
+	{
+	}
+
+	/** Residuals r[3] and, for each non-null pointer, the row-major Jacobians Jq (3x4, w.r.t.
+	 * q_cam_world as x,y,z,w), Jt (3x3), Jp (3x3). False if the point is behind the camera. */
+	bool evaluate(const double* qv, const double* tv, const double* pv, double* r, double* Jq, double* Jt, double* Jp) const
+	{
+		using M3 = Eigen::Matrix3d;
+		const Eigen::Map<const Eigen::Vector3d> v(qv), t(tv), p(pv);
+		const double w = qv[3];
+		const Eigen::Vector3d vxp = v.cross(p);
+		const Eigen::Vector3d pc = p + 2.0 * w * vxp + 2.0 * v.cross(vxp) + t;
+		if (pc.z() <= 1e-6) return false;
+		const double iz = 1.0 / pc.z();
+		const double u = m_K.fx * pc.x() * iz + m_K.cx, vv = m_K.fy * pc.y() * iz + m_K.cy;
+		r[0] = (m_uv.x() - u) * m_invSigma;
+		r[1] = (m_uv.y() - vv) * m_invSigma;
+		r[2] = m_rgbd ? (m_ur - (u - m_bf * iz)) * m_invSigma : 0.0;
+		if (!Jq && !Jt && !Jp) return true;
+		// d r / d pc (3x3, third row zero without depth).
+		const double e = -m_invSigma;
+		Eigen::Matrix3d Jpc;
+		Jpc << e * m_K.fx * iz, 0.0, -e * m_K.fx * pc.x() * iz * iz,  //
+			0.0, e * m_K.fy * iz, -e * m_K.fy * pc.y() * iz * iz,  //
+			0.0, 0.0, 0.0;
+		if (m_rgbd)
+		{
+			Jpc.row(2) = Jpc.row(0);
+			Jpc(2, 2) += e * m_bf * iz * iz;
+		}
+		const auto skew = [](const Eigen::Vector3d& a)
+		{
+			M3 S;
+			S << 0, -a.z(), a.y(), a.z(), 0, -a.x(), -a.y(), a.x(), 0;
+			return S;
+		};
+		using Row33 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+		if (Jt) Eigen::Map<Row33>{Jt} = Jpc;
+		if (Jp)
+		{
+			const M3 V = skew(v);
+			Eigen::Map<Row33>{Jp} = Jpc * (M3::Identity() + 2.0 * w * V + 2.0 * V * V);
+		}
+		if (Jq)
+		{
+			Eigen::Matrix<double, 3, 4> dq;
+			dq.leftCols<3>() = -2.0 * w * skew(p) + 2.0 * (v.dot(p) * M3::Identity() + v * p.transpose() - 2.0 * p * v.transpose());
+			dq.col(3) = 2.0 * vxp;
+			Eigen::Map<Eigen::Matrix<double, 3, 4, Eigen::RowMajor>>{Jq} = Jpc * dq;
+		}
+		return true;
+	}
+
+	bool hasDepth() const { return m_rgbd; }
+
+	Eigen::Vector2d m_uv;
+	double m_ur, m_bf, m_invSigma;
+	bool m_rgbd;
+	PinholeIntrinsics m_K;
+};
+
 /** Wraps a 3-parameter-block cost so that the point is a constant (pose-only problems). */
 template <typename Cost>
 struct FixedPointCost

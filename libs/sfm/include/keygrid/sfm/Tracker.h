@@ -10,6 +10,7 @@
 #include <keygrid/sfm/SparseMap.h>
 #include <keygrid/sfm/TrackerOptions.h>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -46,14 +47,25 @@ struct TrackedFrame
 	/** HOC bookkeeping of this frame (zero when [hoc] is disabled). */
 	HocUpdateStats hoc;
 	double hocSeconds{0};  //!< thread CPU time of HOC selection and update [s]
+	/** When method is "relocalization" and the frame was tracked: the keyframe it was found
+	 * on, and whether place recognition (rather than the newest keyframes) proposed it. */
+	KeyFrameId relocalizationKeyFrame{0};
+	bool relocalizedByPlaceRecognition{false};
 	/** Landmarks in the map after this frame (filled by the application). */
 	std::size_t mapLandmarks{0};
 };
+
+/** Place recognition for relocalization: keyframes that may show the same place as the
+ * given features, best first, at most `maxCandidates` (the loop closer's vocabulary tree). */
+using PlaceRecognizer = std::function<std::vector<KeyFrameId>(const FrameFeatures& features, int maxCandidates)>;
 
 class Tracker
 {
    public:
 	Tracker(SparseMap& map, const TrackerOptions& opts);
+
+	/** When set, relocalization tries these candidates before the newest keyframes. */
+	void setPlaceRecognizer(PlaceRecognizer f) { m_placeRecognizer = std::move(f); }
 
 	/** Tracks one frame whose features were extracted by the caller. In threaded mode the
 	 * caller holds map.mutex() around this call. */
@@ -75,6 +87,8 @@ class Tracker
 		std::vector<LandmarkId> matches;
 		mrpt::poses::CPose3D T_world_cam;
 		int inliers{0};
+		/** Local-map landmarks in view of the pose searched by trackLocalMap (matched or not) */
+		int localMapInView{0};
 		/** HOC: local-map landmarks projected for the final search, those the selection
 		 * excluded, and those matched before it (see HocFrontend::update). */
 		std::vector<ProjectedLandmark> hocVisible, hocExcluded;
@@ -83,7 +97,9 @@ class Tracker
 
 	bool initialize(Current& cur, TrackedFrame& out);
 	bool trackByPrediction(Current& cur);
-	bool trackByPnp(Current& cur, KeyFrameId kf, int minInliers);
+	/** Descriptor matches with keyframe kf's landmarks, PnP-RANSAC, refinement; succeeds with
+	 * at least minRefinedInliers inliers after the refinement. */
+	bool trackByPnp(Current& cur, KeyFrameId kf, int minRefinedInliers);
 	bool relocalize(Current& cur);
 	/** Projects the local map's unmatched landmarks, matches, refines; returns inliers. */
 	int trackLocalMap(Current& cur, float radius);
@@ -113,6 +129,8 @@ class Tracker
 	std::vector<LandmarkId> m_lastInliers;
 	int m_framesLost{0};
 	std::optional<HocFrontend> m_hoc;
+	PlaceRecognizer m_placeRecognizer;
+	bool m_relocRecognized{false};  //!< the last relocalize() succeeded on a recognized place
 	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
 };
 

@@ -26,8 +26,10 @@ struct LoopClosingOptions
 {
 	/** Detect and correct loops (Default: true) */
 	bool enabled{true};
-	/** Vocabulary file (keygrid-vocab train); empty: trained on the first keyframes (Default: empty) */
-	std::string vocabulary;
+	/** "default": the vocabulary shipped in share/vocabulary (ORB features; with SIFT the
+	 * in-run training is used instead), "train": trained on the first train_keyframes
+	 * keyframes of the run, or a file from keygrid-vocab train (Default: default) */
+	std::string vocabulary{"default"};
 	/** Keyframes whose descriptors train the vocabulary when no file is given (Default: 10) */
 	int trainKeyFrames{10};
 	/** Tree shape used for that training (Default: branching 10, 3 levels = 1000 words) */
@@ -56,6 +58,10 @@ struct LoopClosureEvent
 {
 	std::size_t frameIndex{0};
 	sfm::KeyFrameId keyframe{0}, loopKeyFrame{0};
+	double keyframeTimestamp{0}, loopKeyFrameTimestamp{0};  //!< [s], their frames' timestamps
+	/** The verified relative pose T_loop_cur: distance between the two cameras [m] and the
+	 * angle between them [deg] */
+	double measuredDistance{0}, measuredAngleDeg{0};
 	double score{0};
 	int inliers{0};
 	double correctionMetres{0};  //!< how far the current keyframe moved
@@ -66,11 +72,20 @@ struct LoopClosureEvent
 class LoopCloser
 {
    public:
+	/** `featureType` ("orb" or "sift") chooses between the shipped vocabulary and in-run
+	 * training for vocabulary = default; a vocabulary file of another descriptor type throws. */
 	LoopCloser(sfm::SparseMap& map, sfm::LocalMapper& mapper, const LoopClosingOptions& opts,
-			   const sfm::MatcherOptions& matcher);
+			   const sfm::MatcherOptions& matcher, const std::string& featureType = "orb");
+
+	/** Where the vocabulary comes from: its file, or "trained on N keyframes" (for reports). */
+	std::string vocabularySource() const;
 
 	/** Handles keyframe `kf` (after its local mapping). Returns the event if a loop was closed. */
 	std::optional<LoopClosureEvent> process(sfm::KeyFrameId kf, std::size_t frameIndex, const sfm::PinholeIntrinsics& K);
+
+	/** Keyframes of the database that may show the same place as `descriptors`, best first
+	 * (relocalization). Empty until the vocabulary exists. */
+	std::vector<sfm::KeyFrameId> placeCandidates(const cv::Mat& descriptors, int maxCandidates) const;
 
 	bool hasVocabulary() const { return !m_vocab.empty(); }
 	const loop::Vocabulary& vocabulary() const { return m_vocab; }
@@ -90,6 +105,7 @@ class LoopCloser
 	LoopClosingOptions m_opts;
 	sfm::MatcherOptions m_matcher;
 	loop::Vocabulary m_vocab;
+	std::string m_vocabFile;  //!< empty: trained in the run
 	loop::KeyFrameDatabase m_db;
 	std::set<sfm::KeyFrameId> m_dbIds;
 	loop::ConsistencyChecker m_consistency;

@@ -1,0 +1,239 @@
+#include <keygrid/sfm/LocalBundleAdjuster.h>
+#include <keygrid/sfm/LocalMapper.h>
+#include <keygrid/sfm/Matcher.h>
+#include <mrpt/config/CConfigFileMemory.h>
+
+#include <ceres/ceres.h>
+#include <random>
+
+#include "TestData.h"
+
+using namespace keygrid::sfm;
+using mrpt::poses::CPose3D;
+
+namespace
+{
+const PinholeIntrinsics K{517.3, 516.5, 318.6, 255.3};
+
+/** Autodiff of the templated costs, padded to 3 rows (mono: third row 0), for comparison. */
+void autodiffReference(
+	const AnalyticReprojectionCost& c, const double* q, const double* t, const double* p, double r[3], double Jq[12],
+	double Jt[9], double Jp[9])
+{
+	const double* params[3] = {q, t, p};
+	std::fill(r, r + 3, 0.0);
+	std::fill(Jq, Jq + 12, 0.0);
+	std::fill(Jt, Jt + 9, 0.0);
+	std::fill(Jp, Jp + 9, 0.0);
+	double* J[3] = {Jq, Jt, Jp};
+	if (c.hasDepth())
+	{
+		ceres::AutoDiffCostFunction<RgbdReprojectionCost, 3, 4, 3, 3> ad(
+			new RgbdReprojectionCost(c.m_uv, c.m_bf / (c.m_uv.x() - c.m_ur), c.m_bf, c.m_invSigma, c.m_K));
+		ASSERT_TRUE(ad.Evaluate(params, r, J));
+	}
+	else
+	{
+		// 2 rows: row-major blocks fill the first rows of the 3-row buffers.
+		ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3> ad(new MonoReprojectionCost(c.m_uv, c.m_invSigma, c.m_K));
+		ASSERT_TRUE(ad.Evaluate(params, r, J));
+	}
+}
+}  // namespace
+
+TEST(AnalyticReprojectionCost, MatchesAutoDiffOfTheTemplatedCosts)
+{
+	std::mt19937 rng(7);
+	std::uniform_real_distribution<double> U(-1.0, 1.0);
+	for (int trial = 0; trial < 40; trial++)
+	{
+		// Random pose; every other trial a quaternion 5 % off unit norm (Ceres' iterates are
+		// only approximately unit), which the polynomial Jacobians must also handle.
+		Eigen::Quaterniond q(Eigen::AngleAxisd(U(rng), Eigen::Vector3d(U(rng), U(rng), U(rng)).normalized()));
+		q.coeffs() *= trial % 2 ? 1.05 : 1.0;
+		double qv[4] = {q.x(), q.y(), q.z(), q.w()}, t[3] = {0.2 * U(rng), 0.2 * U(rng), 0.2 * U(rng)};
+		double p[3] = {U(rng), U(rng), 2.5 + U(rng)};
+		const Eigen::Vector2d uv(320 + 100 * U(rng), 240 + 100 * U(rng));
+		const double depth = trial % 3 == 0 ? 0.0 : 2.0 + U(rng);
+		const AnalyticReprojectionCost c(uv, depth, 40.0, 1.0 / 1.44, K);
+		ASSERT_EQ(c.hasDepth(), depth > 0);
+		double r[3], Jq[12], Jt[9], Jp[9], rr[3], Rq[12], Rt[9], Rp[9];
+		ASSERT_TRUE(c.evaluate(qv, t, p, r, Jq, Jt, Jp));
+		autodiffReference(c, qv, t, p, rr, Rq, Rt, Rp);
+		for (int k = 0; k < 3; k++) EXPECT_NEAR(r[k], rr[k], 1e-9 * (1 + std::abs(rr[k]))) << "trial " << trial;
+		for (int k = 0; k < 12; k++) EXPECT_NEAR(Jq[k], Rq[k], 1e-8 * (1 + std::abs(Rq[k]))) << "trial " << trial << " Jq " << k;
+		for (int k = 0; k < 9; k++)
+		{
+			EXPECT_NEAR(Jt[k], Rt[k], 1e-8 * (1 + std::abs(Rt[k]))) << "trial " << trial << " Jt " << k;
+			EXPECT_NEAR(Jp[k], Rp[k], 1e-8 * (1 + std::abs(Rp[k]))) << "trial " << trial << " Jp " << k;
+		}
+		// Residuals alone (no Jacobians requested) are the same numbers.
+		double r2[3];
+		ASSERT_TRUE(c.evaluate(qv, t, p, r2, nullptr, nullptr, nullptr));
+		for (int k = 0; k < 3; k++) EXPECT_EQ(r[k], r2[k]);
+	}
+	// Behind the camera: rejected like the templated costs.
+	const AnalyticReprojectionCost c({300, 200}, 1.5, 40.0, 1.0, K);
+	double qv[4] = {0, 0, 0, 1}, t[3] = {0, 0, 0}, p[3] = {0.1, 0.1, -1.0}, r[3];
+	EXPECT_FALSE(c.evaluate(qv, t, p, r, nullptr, nullptr, nullptr));
+}
+
+TEST(LocalMapper, SubsetMatchingEqualsFilteredBruteForce)
+{
+	// Random ORB-like descriptors; b holds noisy copies of a's so that there are real matches,
+	// duplicated rows create exact ties.
+	std::mt19937 rng(3);
+	const int n = 300;
+	FrameFeatures a, b;
+	a.descriptors = cv::Mat(n, 32, CV_8U);
+	cv::randu(a.descriptors, 0, 256);
+	b.descriptors = a.descriptors.clone();
+	for (int i = 0; i < n; i++)
+	{
+		const int flips = static_cast<int>(rng() % 60);
+		for (int f = 0; f < flips; f++) b.descriptors.at<uint8_t>(i, static_cast<int>(rng() % 32)) ^= static_cast<uint8_t>(1u << (rng() % 8));
+	}
+	a.descriptors.row(5).copyTo(a.descriptors.row(6));
+	b.descriptors.row(10).copyTo(b.descriptors.row(11));
+	std::vector<int> ia;
+	for (int i = 0; i < n; i++)
+		if (i % 3 != 1) ia.push_back(i);
+	MatcherOptions mo;
+	std::vector<std::pair<int, int>> expected;
+	for (const auto& m : matchBruteForce(a, b, mo, 0.8f))
+		if (std::find(ia.begin(), ia.end(), m.first) != ia.end()) expected.push_back(m);
+	const auto got = matchSubsetBruteForce(a, ia, b, mo.maxDistance(true), 0.8f);
+	EXPECT_GT(expected.size(), 50u);
+	EXPECT_EQ(got, expected);
+}
+
+namespace
+{
+/** Four keyframes observing 80 points (half with depth), exact measurements. */
+struct Scene
+{
+	SparseMap map;
+	std::vector<CPose3D> truePoses;
+	std::vector<Eigen::Vector3d> truePoints;
+};
+
+void buildScene(Scene& s, double poseNoise, double pointNoise)
+{
+	std::mt19937 rng(11);
+	std::uniform_real_distribution<double> U(-1.0, 1.0);
+	std::normal_distribution<double> N(0.0, 1.0);
+	const int nPts = 80;
+	for (int i = 0; i < nPts; i++) s.truePoints.emplace_back(0.8 * U(rng), 0.6 * U(rng), 2.2 + 0.6 * U(rng));
+	s.truePoses = {
+		CPose3D(0, 0, 0, 0, 0, 0), CPose3D(0.10, 0.01, 0.02, 0.03, 0.01, 0.0), CPose3D(0.2, -0.02, 0.0, 0.05, -0.02, 0.01),
+		CPose3D(0.3, 0.0, 0.05, 0.08, 0.0, -0.02)};
+	cv::Mat desc(nPts, 32, CV_8U);
+	cv::randu(desc, 0, 256);
+	for (std::size_t k = 0; k < s.truePoses.size(); k++)
+	{
+		KeyFrame kf;
+		kf.T_world_cam = k == 0 ? s.truePoses[k]
+								: s.truePoses[k] + CPose3D(poseNoise * N(rng), poseNoise * N(rng), poseNoise * N(rng),
+													   poseNoise * N(rng), poseNoise * N(rng), poseNoise * N(rng));
+		auto& f = kf.features;
+		f.levelScale = {1.0, 1.2};
+		f.numLevels = 2;
+		f.descriptors = desc.clone();
+		for (int i = 0; i < nPts; i++)
+		{
+			double x, y, z;
+			(-s.truePoses[k]).composePoint(s.truePoints[i].x(), s.truePoints[i].y(), s.truePoints[i].z(), x, y, z);
+			cv::KeyPoint kp(static_cast<float>(K.fx * x / z + K.cx), static_cast<float>(K.fy * y / z + K.cy), 8.f);
+			kp.octave = i % 2;
+			f.keypoints.push_back(kp);
+			f.undistorted.emplace_back(static_cast<float>(K.fx * x / z + K.cx), static_cast<float>(K.fy * y / z + K.cy));
+			f.depth.push_back(i % 2 == 0 ? static_cast<float>(z) : 0.f);
+		}
+		s.map.addKeyFrame(std::move(kf));
+	}
+	for (int i = 0; i < nPts; i++)
+	{
+		const Eigen::Vector3d p0 = s.truePoints[i] + pointNoise * Eigen::Vector3d(N(rng), N(rng), N(rng));
+		const LandmarkId id = s.map.addLandmark(p0, 0, i);
+		for (KeyFrameId k = 1; k < s.truePoses.size(); k++) s.map.addObservation(id, k, i);
+	}
+	for (KeyFrameId k = 0; k < s.truePoses.size(); k++) s.map.updateCovisibility(k);
+}
+}  // namespace
+
+TEST(LocalBundleAdjuster, RecoversTheSceneWithEverySolverAndJacobian)
+{
+	// Exact measurements (up to float pixels), perturbed start: every solver / Jacobian variant
+	// must return to the ground truth.
+	std::vector<CPose3D> results;
+	for (const auto solver : {BaLinearSolver::Auto, BaLinearSolver::DenseSchur, BaLinearSolver::SparseSchur, BaLinearSolver::IterativeSchur})
+		for (bool analytic : {true, false})
+		{
+			Scene s;
+			buildScene(s, 0.01, 0.02);
+			BundleAdjusterOptions o;
+			o.linearSolver = solver;
+			o.analyticJacobians = analytic;
+			o.iterations = 30;
+			o.bf = 40.0;
+			const auto rep = localBundleAdjustment(s.map, 3, K, o);
+			EXPECT_EQ(rep.keyframes, 4);
+			EXPECT_EQ(rep.landmarks, 80);
+			EXPECT_EQ(rep.observations, 320);
+			EXPECT_EQ(rep.outliersRemoved, 0);
+			EXPECT_LT(rep.finalCost, 1e-3 * rep.initialCost);
+			// Keyframe 0 is the gauge and stays put; the others return to the truth.
+			for (KeyFrameId k = 0; k < 4; k++)
+			{
+				const CPose3D& T = s.map.keyframe(k).T_world_cam;
+				EXPECT_LT((T - s.truePoses[k]).translation().norm(), 2e-4) << "kf " << k << " solver " << int(solver) << " analytic " << analytic;
+				const Eigen::Matrix3d dR = (T - s.truePoses[k]).getRotationMatrix().asEigen();
+				EXPECT_LT(std::acos(std::min(1.0, (dR.trace() - 1.0) / 2.0)), 1e-4) << "kf " << k;
+			}
+			for (int i = 0; i < 80; i++) EXPECT_LT((s.map.landmark(static_cast<LandmarkId>(i)).p_world - s.truePoints[i]).norm(), 1e-3);
+			results.push_back(s.map.keyframe(3).T_world_cam);
+		}
+	// Analytic and autodiff Jacobians, any linear solver: the same optimum.
+	for (const auto& r : results) EXPECT_LT((r - results.front()).translation().norm(), 1e-6);
+}
+
+TEST(LocalBundleAdjuster, RemovesAGrossOutlierObservation)
+{
+	Scene s;
+	buildScene(s, 0.005, 0.005);
+	// Keypoint 4 of keyframe 2 moved by 40 px: its observation must go, nothing else.
+	s.map.keyframe(2).features.undistorted[4].x += 40.f;
+	BundleAdjusterOptions o;
+	o.iterations = 30;
+	const auto rep = localBundleAdjustment(s.map, 3, K, o);
+	EXPECT_EQ(rep.outliersRemoved, 1);
+	EXPECT_EQ(s.map.landmark(4).observations.count(2), 0u);
+	EXPECT_LT((s.map.keyframe(2).T_world_cam - s.truePoses[2]).translation().norm(), 1e-3);
+}
+
+TEST(LocalBundleAdjuster, OptionsRoundTripAndRejectUnknownSolver)
+{
+	mrpt::config::CConfigFileMemory saved;
+	BundleAdjusterOptions o;
+	o.linearSolver = BaLinearSolver::IterativeSchur;
+	o.analyticJacobians = false;
+	o.saveToConfigFile(saved, "mapping");
+	// Read back from the text, as a file would be.
+	std::string text;
+	saved.getContent(text);
+	mrpt::config::CConfigFileMemory cfg(text);
+	BundleAdjusterOptions back;
+	back.loadFromConfigFile(cfg, "mapping");
+	EXPECT_EQ(back.linearSolver, BaLinearSolver::IterativeSchur);
+	EXPECT_FALSE(back.analyticJacobians);
+	cfg = mrpt::config::CConfigFileMemory("[mapping]\nlinear_solver = cholmod\n");
+	try
+	{
+		back.loadFromConfigFile(cfg, "mapping");
+		FAIL() << "no exception";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("linear_solver = cholmod"), std::string::npos) << e.what();
+	}
+}
