@@ -31,11 +31,9 @@ Tracker::Tracker(SparseMap& map, const TrackerOptions& opts) : m_map(map), m_opt
 
 bool Tracker::hocUsable(LandmarkId id, const Current& cur)
 {
-	if (!m_hoc) return true;
-	const double t0 = threadCpuSeconds();
-	const bool ok = m_hoc->usable(m_map.landmark(id), m_map, translationOf(cur.T_world_cam));
-	m_hocSelectionSeconds += threadCpuSeconds() - t0;
-	return ok;
+	// Untimed: callers time whole selection passes. A thread-CPU clock read costs ~1 us here,
+	// more than the selection of one landmark, so timing each call inflated the HOC cost.
+	return !m_hoc || m_hoc->usable(m_map.landmark(id), m_map, translationOf(cur.T_world_cam));
 }
 
 TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
@@ -192,7 +190,7 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool
 {
 	std::set<LandmarkId> already(cur.matches.begin(), cur.matches.end());
 	std::set<LandmarkId> seen;
-	std::vector<ProjectedLandmark> out;
+	std::vector<ProjectedLandmark> inView;
 	const auto T_cam_world = -cur.T_world_cam;
 	const Eigen::Vector3d center = translationOf(cur.T_world_cam);
 	for (KeyFrameId kfId : m_localKfs)
@@ -202,18 +200,31 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool
 		{
 			if (id == kNoLandmark || already.count(id) || !seen.insert(id).second) continue;
 			if (!m_map.hasLandmark(id)) continue;
-			auto& lm = m_map.landmark(id);
 			ProjectedLandmark p;
-			if (!projectLandmark(lm, T_cam_world, center, m_K, cur.features, m_opts.matcher, p)) continue;
-			if (!hocUsable(id, cur))
-			{
-				if (forLocalMap) cur.hocExcluded.push_back(p);
-				continue;
-			}
-			if (forLocalMap) lm.visibleCount++;
-			out.push_back(p);
+			if (projectLandmark(m_map.landmark(id), T_cam_world, center, m_K, cur.features, m_opts.matcher, p)) inView.push_back(p);
 		}
 	}
+	if (!m_hoc)
+	{
+		if (forLocalMap)
+			for (const auto& p : inView) m_map.landmark(p.id).visibleCount++;
+		return inView;
+	}
+	// HOC selection, timed as one pass.
+	const double t0 = threadCpuSeconds();
+	std::vector<ProjectedLandmark> out;
+	out.reserve(inView.size());
+	for (const auto& p : inView)
+	{
+		if (!hocUsable(p.id, cur))
+		{
+			if (forLocalMap) cur.hocExcluded.push_back(p);
+			continue;
+		}
+		if (forLocalMap) m_map.landmark(p.id).visibleCount++;
+		out.push_back(p);
+	}
+	m_hocSelectionSeconds += threadCpuSeconds() - t0;
 	return out;
 }
 
@@ -266,10 +277,18 @@ bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minRefinedInliers)
 	for (const auto& [i, j] : pairs)
 	{
 		const LandmarkId lm = kf.landmarks[j];
-		if (lm == kNoLandmark || !m_map.hasLandmark(lm) || !hocUsable(lm, cur)) continue;
+		if (lm != kNoLandmark && m_map.hasLandmark(lm)) link.emplace_back(i, lm);
+	}
+	if (m_hoc)
+	{
+		const double t0 = threadCpuSeconds();
+		link.erase(std::remove_if(link.begin(), link.end(), [&](const auto& l) { return !hocUsable(l.second, cur); }), link.end());
+		m_hocSelectionSeconds += threadCpuSeconds() - t0;
+	}
+	for (const auto& [i, lm] : link)
+	{
 		pw.push_back(m_map.landmark(lm).p_world);
 		px.emplace_back(cur.features.undistorted[i].x, cur.features.undistorted[i].y);
-		link.emplace_back(i, lm);
 	}
 	const auto res = solvePnpRansac(pw, px, m_K, m_opts.pnp);
 	if (!res.ok) return false;
