@@ -2,8 +2,10 @@
 // far side of a generated room loop back to views of its start, which only old keyframes
 // show. The tracker must find them through the loop closer's keyframe database and continue
 // at the true pose (aligned on the part before the jump, so a look-alike place would show).
+#include <keygrid/core/TumText.h>
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/eval/Alignment.h>
+#include <keygrid/sfm/SparseMap.h>
 #include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/system/filesystem.h>
 
@@ -12,30 +14,8 @@
 #include <cstdio>
 #include <fstream>
 #include <regex>
-#include <sstream>
 
 using namespace keygrid;
-
-namespace
-{
-/** Lines of a text file that are not comments. */
-std::vector<std::string> dataLines(const std::string& path)
-{
-	std::vector<std::string> out;
-	std::ifstream f(path);
-	for (std::string l; std::getline(f, l);)
-		if (!l.empty() && l[0] != '#') out.push_back(l);
-	return out;
-}
-
-std::string field(const std::string& line, int k)
-{
-	std::istringstream is(line);
-	std::string s;
-	for (int i = 0; i <= k; i++) is >> s;
-	return s;
-}
-}  // namespace
 
 TEST(Relocalization, KidnappedCameraIsRelocalizedOnOldKeyframesThroughTheVocabulary)
 {
@@ -49,8 +29,8 @@ TEST(Relocalization, KidnappedCameraIsRelocalizedOnOldKeyframesThroughTheVocabul
 		0)
 		<< log;
 	// Frames 0..149 (half of the circle), then frames 20..59 again: the start of the loop.
-	const auto assoc = dataLines(dir + "/seq/tum/associations.txt");
-	const auto gt = dataLines(dir + "/seq/groundtruth.txt");
+	const auto assoc = core::readTumTextRecords(dir + "/seq/tum/associations.txt");
+	const auto gt = core::readTumTrajectory(dir + "/seq/groundtruth.txt");
 	ASSERT_EQ(assoc.size(), 300u);
 	ASSERT_EQ(gt.size(), 300u);
 	std::vector<int> order;
@@ -58,17 +38,19 @@ TEST(Relocalization, KidnappedCameraIsRelocalizedOnOldKeyframesThroughTheVocabul
 	const std::size_t kidnap = order.size();
 	for (int i = 20; i < 60; i++) order.push_back(i);
 	mrpt::system::createDirectory(dir + "/kidnapped");
+	core::Trajectory kidnappedGt;
 	{
-		std::ofstream a(dir + "/kidnapped/associations.txt"), g(dir + "/kidnapped/groundtruth.txt");
+		std::ofstream a(dir + "/kidnapped/associations.txt");
 		for (std::size_t k = 0; k < order.size(); k++)
 		{
 			char t[32];
 			std::snprintf(t, sizeof(t), "%.6f", 1700000000.0 + k / 30.0);
-			const auto& l = assoc[order[k]];
-			a << t << " ../seq/tum/" << field(l, 1) << " " << t << " ../seq/tum/" << field(l, 3) << "\n";
-			g << t << gt[order[k]].substr(gt[order[k]].find(' ')) << "\n";
+			const auto& f = assoc[order[k]].fields;
+			a << t << " ../seq/tum/" << f.at(1) << " " << t << " ../seq/tum/" << f.at(3) << "\n";
+			kidnappedGt.push_back({std::stod(t), gt[order[k]].T_world_cam});
 		}
 	}
+	core::writeTumTrajectory(dir + "/kidnapped/groundtruth.txt", kidnappedGt);
 
 	slam::SlamRunOptions o;
 	o.configPath = test::sourceDir() + "/config/sim.ini";
@@ -92,21 +74,18 @@ TEST(Relocalization, KidnappedCameraIsRelocalizedOnOldKeyframesThroughTheVocabul
 	// Align on the frames before the jump, then every frame from 3 after it must be at its
 	// true pose (measured: 3 mm).
 	const auto est = core::readTumTrajectory(o.output + "/trajectory.txt");
-	const auto ref = core::readTumTrajectory(dir + "/kidnapped/groundtruth.txt");
+	const auto& ref = kidnappedGt;
 	ASSERT_EQ(est.size(), order.size());
 	ASSERT_EQ(ref.size(), order.size());
-	auto position = [](const core::StampedPose& p) {
-		return Eigen::Vector3d(p.T_world_cam.x(), p.T_world_cam.y(), p.T_world_cam.z());
-	};
 	std::vector<Eigen::Vector3d> x, y;
 	for (std::size_t k = 0; k < kidnap; k++)
 	{
-		x.push_back(position(est[k]));
-		y.push_back(position(ref[k]));
+		x.push_back(sfm::translationOf(est[k].T_world_cam));
+		y.push_back(sfm::translationOf(ref[k].T_world_cam));
 	}
 	const auto S = eval::alignPointSets(x, y, false);
 	double worst = 0;
 	for (std::size_t k = kidnap + 3; k < order.size(); k++)
-		worst = std::max(worst, (S.apply(position(est[k])) - position(ref[k])).norm());
+		worst = std::max(worst, (S.apply(sfm::translationOf(est[k].T_world_cam)) - sfm::translationOf(ref[k].T_world_cam)).norm());
 	EXPECT_LT(worst, 0.02);
 }

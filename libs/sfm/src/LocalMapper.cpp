@@ -5,62 +5,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#include <limits>
 #include <set>
 
 namespace keygrid::sfm
 {
-std::vector<std::pair<int, int>> matchSubsetBruteForce(
-	const FrameFeatures& a, const std::vector<int>& ia, const FrameFeatures& b, float maxDist, float ratio)
-{
-	std::vector<std::pair<int, int>> out;
-	const int na = a.descriptors.rows, nb = b.descriptors.rows;
-	if (ia.empty() || nb == 0) return out;
-	// Binary descriptors (whole 64-bit words, continuous rows): Hamming distance on the raw
-	// rows, which avoids a cv::Mat header per pair; otherwise descriptorDistance.
-	const bool raw = a.descriptors.type() == CV_8U && a.descriptors.cols % 8 == 0 && a.descriptors.isContinuous() &&
-		b.descriptors.isContinuous() && b.descriptors.type() == CV_8U && b.descriptors.cols == a.descriptors.cols;
-	const int words = a.descriptors.cols / 8;
-	const auto distance = [&](const cv::Mat& da, int ra, const cv::Mat& db, int rb) -> float
-	{
-		if (!raw) return descriptorDistance(da.row(ra), db.row(rb));
-		const auto* pa = da.ptr<std::uint64_t>(ra);
-		const auto* pb = db.ptr<std::uint64_t>(rb);
-		int d = 0;
-		for (int w = 0; w < words; w++) d += __builtin_popcountll(pa[w] ^ pb[w]);
-		return static_cast<float>(d);
-	};
-	for (int i : ia)
-	{
-		int best = -1;
-		float d1 = std::numeric_limits<float>::max(), d2 = d1;
-		for (int j = 0; j < nb; j++)
-		{
-			const float d = distance(a.descriptors, i, b.descriptors, j);
-			if (d < d1)
-			{
-				d2 = d1;
-				d1 = d;
-				best = j;
-			}
-			else if (d < d2)
-				d2 = d;
-		}
-		if (d1 > maxDist || (nb > 1 && d1 > ratio * d2)) continue;
-		// Mutual best: b's keypoint has no closer keypoint in a (nor an equal one before i).
-		bool mutual = true;
-		for (int k = 0; k < na && mutual; k++)
-		{
-			if (k == i) continue;
-			const float d = distance(a.descriptors, k, b.descriptors, best);
-			if (d < d1 || (d == d1 && k < i)) mutual = false;
-		}
-		if (mutual) out.emplace_back(i, best);
-	}
-	return out;
-}
-
 void LocalMapperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
 	fuseNeighbours = c.read_int(s, "fuse_neighbours", fuseNeighbours);

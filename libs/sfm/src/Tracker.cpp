@@ -96,9 +96,8 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		// A look-alike place matches a few dozen landmarks of a local map that shows hundreds
 		// in view; the true place matches a good share of them.
 		if (ok && out.method == "relocalization")
-			ok = cur.inliers >= m_opts.relocalizationMinInlierRatio * cur.localMapInView;
-		if (ok && out.method == "relocalization")
 		{
+			ok = cur.inliers >= m_opts.relocalizationMinInlierRatio * cur.localMapInView;
 			out.relocalizationKeyFrame = m_refKf;
 			out.relocalizedByPlaceRecognition = m_relocRecognized;
 		}
@@ -204,14 +203,8 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool
 			if (projectLandmark(m_map.landmark(id), T_cam_world, center, m_K, cur.features, m_opts.matcher, p)) inView.push_back(p);
 		}
 	}
-	if (!m_hoc)
-	{
-		if (forLocalMap)
-			for (const auto& p : inView) m_map.landmark(p.id).visibleCount++;
-		return inView;
-	}
-	// HOC selection, timed as one pass.
-	const double t0 = threadCpuSeconds();
+	// HOC selection (everything passes without HOC), timed as one pass.
+	const double t0 = m_hoc ? threadCpuSeconds() : 0.0;
 	std::vector<ProjectedLandmark> out;
 	out.reserve(inView.size());
 	for (const auto& p : inView)
@@ -224,7 +217,7 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool
 		if (forLocalMap) m_map.landmark(p.id).visibleCount++;
 		out.push_back(p);
 	}
-	m_hocSelectionSeconds += threadCpuSeconds() - t0;
+	if (m_hoc) m_hocSelectionSeconds += threadCpuSeconds() - t0;
 	return out;
 }
 

@@ -56,6 +56,15 @@ int searchByProjection(
 std::vector<std::pair<int, int>> matchBruteForce(
 	const FrameFeatures& a, const FrameFeatures& b, const MatcherOptions& o, float ratio = 0.8f);
 
+/** The matches of matchBruteForce(a, b, ratio) (mutual nearest neighbours over all keypoints of
+ * both sets, distance <= maxDist, best / second-best ratio) whose keypoint in a is one of `ia`,
+ * without the full |a| x |b| distance table: each row of `ia` is scanned against all of b and
+ * only its best match is checked for mutuality against all of a. Ties go to the lower index,
+ * as in OpenCV's brute-force matcher. Used for triangulation, where only the few keypoints of
+ * the new keyframe without landmark and depth are candidates: O(|ia| |b| + |matches| |a|). */
+std::vector<std::pair<int, int>> matchSubsetBruteForce(
+	const FrameFeatures& a, const std::vector<int>& ia, const FrameFeatures& b, float maxDist, float ratio);
+
 /** Predicted pyramid level of a landmark seen at distance `dist`. */
 int predictLevel(const Landmark& lm, double dist, const FrameFeatures& f);
 
