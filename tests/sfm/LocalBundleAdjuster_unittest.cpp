@@ -211,6 +211,32 @@ TEST(LocalBundleAdjuster, RemovesAGrossOutlierObservation)
 	EXPECT_LT((s.map.keyframe(2).T_world_cam - s.truePoses[2]).translation().norm(), 1e-3);
 }
 
+TEST(LocalBundleAdjuster, SolvedApartFromTheMapAndAppliedToWhatIsStillThere)
+{
+	// Threaded mode's sequence: build from the map, let tracking change the map (a landmark
+	// erased, one moved by hand), solve without the map, write back.
+	Scene s, ref;
+	buildScene(s, 0.01, 0.02);
+	buildScene(ref, 0.01, 0.02);
+	BundleAdjusterOptions o;
+	o.iterations = 30;
+	auto ba = BundleAdjustment::around(s.map, 3, K, o);
+	s.map.eraseLandmark(7);
+	s.map.landmark(8).p_world = Eigen::Vector3d(9, 9, 9);
+	ba.solve();
+	const auto rep = ba.apply(s.map);
+	// The result is the one-step adjustment's (built from the same state)...
+	const auto repRef = localBundleAdjustment(ref.map, 3, K, o);
+	EXPECT_EQ(rep.observations, repRef.observations);
+	EXPECT_DOUBLE_EQ(rep.finalCost, repRef.finalCost);
+	for (KeyFrameId k = 1; k < 4; k++)
+		EXPECT_LT((s.map.keyframe(k).T_world_cam - ref.map.keyframe(k).T_world_cam).translation().norm(), 1e-12);
+	// ...the erased landmark stays erased, the other one gets the solved position.
+	EXPECT_FALSE(s.map.hasLandmark(7));
+	EXPECT_LT((s.map.landmark(8).p_world - s.truePoints[8]).norm(), 1e-3);
+	EXPECT_EQ(s.map.numLandmarks(), 79u);
+}
+
 TEST(LocalBundleAdjuster, OptionsRoundTripAndRejectUnknownSolver)
 {
 	mrpt::config::CConfigFileMemory saved;

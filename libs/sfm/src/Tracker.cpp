@@ -146,8 +146,17 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		out.reference = m_refKf;
 		out.T_ref_cam = cur.T_world_cam - m_map.keyframe(m_refKf).T_world_cam;
 		out.hasReference = true;
+		m_lastRelative.emplace(m_refKf, out.T_ref_cam);
 	}
+	else
+		m_lastRelative.reset();
 	return out;
+}
+
+void Tracker::onMapCorrected()
+{
+	mrpt::poses::CPose3D T_world_ref;
+	if (m_lastRelative && m_map.poseOf(m_lastRelative->first, T_world_ref)) m_lastPose = T_world_ref + m_lastRelative->second;
 }
 
 bool Tracker::initialize(Current& cur, TrackedFrame& out)

@@ -125,8 +125,9 @@ std::vector<sfm::KeyFrameId> LoopCloser::placeCandidates(const cv::Mat& descript
 	return out;
 }
 
-std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const loop::BowVector& bow, double& score)
+std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const loop::BowVector& bow, double& score, LoopQueryRecord& rec)
 {
+	const auto t0 = std::chrono::steady_clock::now();
 	// Reference: the lowest similarity with the covisible keyframes (ORB-SLAM's normalisation).
 	const auto covis = m_map.bestCovisibles(kfId, 1000);
 	double ref = 1.0;
@@ -142,6 +143,14 @@ std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const lo
 	for (const auto& [id, kf] : m_map.keyframes())
 		if (id + static_cast<sfm::KeyFrameId>(m_opts.minKeyFrameGap) > kfId) q.exclude.insert(id);
 	const auto cands = m_db.query(bow, q);
+	rec.querySeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+	rec.referenceScore = ref;
+	rec.candidates = static_cast<int>(cands.size());
+	if (!cands.empty())
+	{
+		rec.bestCandidate = cands.front().id;
+		rec.bestScore = cands.front().score;
+	}
 	std::vector<loop::CandidateGroup> groups;
 	for (const auto& c : cands)
 	{
@@ -162,7 +171,7 @@ std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const lo
 	return std::nullopt;
 }
 
-bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, int& inliers)
+bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, LoopQueryRecord& rec)
 {
 	const auto& a = m_map.keyframe(cand);
 	const auto& b = m_map.keyframe(cur);
@@ -174,10 +183,19 @@ bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::Pi
 		pa.push_back(sfm::backProject(K, a.features.undistorted[i].x, a.features.undistorted[i].y, da));
 		pb.push_back(sfm::backProject(K, b.features.undistorted[j].x, b.features.undistorted[j].y, db));
 	}
-	if (static_cast<int>(pa.size()) < m_opts.ransac.minInliers) return false;
+	rec.matches = static_cast<int>(pa.size());
+	if (static_cast<int>(pa.size()) < m_opts.ransac.minInliers)
+	{
+		rec.outcome = "few_matches";
+		return false;
+	}
 	const auto r = loop::estimateRigidTransformRansac(pa, pb, m_opts.ransac);
-	inliers = r.numInliers;
-	if (!r.success) return false;
+	rec.inliers = r.numInliers;
+	if (!r.success)
+	{
+		rec.outcome = "ransac_failed";
+		return false;
+	}
 	T_cand_cur = r.T_a_b;
 	return true;
 }
@@ -267,6 +285,36 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 	return ev;
 }
 
+std::optional<LoopClosureEvent> LoopCloser::closeVerifiedLoop(
+	sfm::KeyFrameId kf, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, std::size_t frameIndex, double score,
+	const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec)
+{
+	if (!plausible(kf, cand, T_cand_cur))
+	{
+		rejectedImplausible++;
+		rec.outcome = "implausible";
+		return std::nullopt;
+	}
+	auto ev = correct(kf, cand, T_cand_cur, K);
+	if (ev.newPoses.empty())
+	{
+		rec.outcome = "pose_graph_failed";
+		return std::nullopt;
+	}
+	ev.frameIndex = frameIndex;
+	ev.keyframeTimestamp = m_map.keyframe(kf).timestamp;
+	ev.loopKeyFrameTimestamp = m_map.keyframe(cand).timestamp;
+	ev.measuredDistance = T_cand_cur.translation().norm();
+	ev.measuredAngleDeg = Eigen::AngleAxisd(T_cand_cur.linear()).angle() * 180.0 / M_PI;
+	ev.score = score;
+	ev.inliers = rec.inliers;
+	m_lastLoopKf = kf;
+	m_anyLoop = true;
+	m_consistency.reset();
+	rec.outcome = "closed";
+	return ev;
+}
+
 std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::size_t frameIndex, const sfm::PinholeIntrinsics& K)
 {
 	if (!m_opts.enabled || !m_map.hasKeyFrame(kf)) return std::nullopt;
@@ -279,44 +327,35 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 		}
 		else
 			++it;
+	LoopQueryRecord rec;
+	rec.keyframe = kf;
+	rec.frameIndex = frameIndex;
 	if (m_vocab.empty())
 	{
 		trainIfReady();
+		rec.outcome = "no_vocabulary";
+		m_queries.push_back(rec);
 		return std::nullopt;
 	}
 	const auto t0 = std::chrono::steady_clock::now();
 	const loop::BowVector bow = m_vocab.transform(m_map.keyframe(kf).features.descriptors);
+	rec.querySeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	double score = 0;
 	std::optional<LoopClosureEvent> out;
 	// No detection right after a loop: the map around it is still being joined.
-	if (!m_anyLoop || kf > m_lastLoopKf + 5)
-		if (auto cand = detect(kf, bow, score))
-		{
-			Eigen::Isometry3d T_cand_cur = Eigen::Isometry3d::Identity();
-			int inliers = 0;
-			const bool verified = verify(kf, *cand, K, T_cand_cur, inliers);
-			if (verified && !plausible(kf, *cand, T_cand_cur))
-				rejectedImplausible++;
-			else if (verified)
-			{
-				auto ev = correct(kf, *cand, T_cand_cur, K);
-				if (!ev.newPoses.empty())
-				{
-					ev.frameIndex = frameIndex;
-					ev.keyframeTimestamp = m_map.keyframe(kf).timestamp;
-					ev.loopKeyFrameTimestamp = m_map.keyframe(*cand).timestamp;
-					ev.measuredDistance = T_cand_cur.translation().norm();
-					ev.measuredAngleDeg = Eigen::AngleAxisd(T_cand_cur.linear()).angle() * 180.0 / M_PI;
-					ev.score = score;
-					ev.inliers = inliers;
-					ev.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-					m_lastLoopKf = kf;
-					m_anyLoop = true;
-					m_consistency.reset();
-					out = ev;
-				}
-			}
-		}
+	if (m_anyLoop && kf <= m_lastLoopKf + 5)
+		rec.outcome = "after_loop";
+	else if (auto cand = detect(kf, bow, score, rec); !cand)
+		rec.outcome = rec.candidates ? "not_consistent" : "no_candidate";
+	else
+	{
+		rec.verifiedCandidate = *cand;
+		Eigen::Isometry3d T_cand_cur = Eigen::Isometry3d::Identity();
+		if (verify(kf, *cand, K, T_cand_cur, rec))  // else verify() named the outcome
+			out = closeVerifiedLoop(kf, *cand, T_cand_cur, frameIndex, score, K, rec);
+		if (out) out->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+	}
+	m_queries.push_back(rec);
 	m_db.add(kf, bow);
 	m_dbIds.insert(kf);
 	return out;

@@ -10,9 +10,13 @@ namespace keygrid::slam
 StageTimings::Summary StageTimings::summary(const std::string& stage) const
 {
 	Summary s;
-	auto it = m_samples.find(stage);
-	if (it == m_samples.end() || it->second.empty()) return s;
-	std::vector<double> v = it->second;
+	std::vector<double> v;
+	{
+		std::lock_guard<std::mutex> lk(m_mutex);
+		auto it = m_samples.find(stage);
+		if (it == m_samples.end() || it->second.empty()) return s;
+		v = it->second;
+	}
 	std::sort(v.begin(), v.end());
 	s.count = v.size();
 	for (double x : v) s.total += x;
@@ -27,6 +31,7 @@ StageTimings::Summary StageTimings::summary(const std::string& stage) const
 
 std::vector<std::string> StageTimings::stages() const
 {
+	std::lock_guard<std::mutex> lk(m_mutex);
 	std::vector<std::string> out;
 	for (const auto& [k, v] : m_samples) out.push_back(k);
 	return out;

@@ -1,6 +1,7 @@
 #include <keygrid/slam/System.h>
 
 #include <chrono>
+#include <stdexcept>
 
 namespace keygrid::slam
 {
@@ -24,7 +25,18 @@ System::System(const SlamConfig& cfg)
 		// Relocalization asks the loop closer's keyframe database (vocabulary tree) first.
 		m_tracker.setPlaceRecognizer([this](const sfm::FrameFeatures& f, int n) { return m_loopCloser->placeCandidates(f.descriptors, n); });
 	}
+	if (cfg.mode == "threaded")
+	{
+		// A few keyframes may wait for local mapping; beyond that tracking waits (back pressure
+		// instead of an ever longer backlog on a slow machine).
+		m_mappingQueue = std::make_unique<core::BoundedQueue<KeyFrameJob>>(4);
+		m_loopQueue = std::make_unique<core::BoundedQueue<KeyFrameJob>>(16);
+		m_mapping = std::thread([this] { mappingThread(); });
+		m_loopClosing = std::thread([this] { loopClosingThread(); });
+	}
 }
+
+System::~System() { joinThreads(); }
 
 sfm::FrameFeatures System::extract(const core::Frame& frame) const { return m_extractor.extract(frame); }
 
@@ -38,78 +50,188 @@ const sfm::TrackedFrame& System::process(const core::Frame& frame)
 
 const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm::FrameFeatures features)
 {
+	throwIfBackgroundFailed();
+	std::unique_lock<std::mutex> lock(m_map.mutex());
 	auto t0 = std::chrono::steady_clock::now();
 	const sfm::PinholeIntrinsics K = sfm::intrinsicsOf(features.camera);
 	if (!m_K) m_K = K;
 	sfm::TrackedFrame tf = m_tracker.track(frame, std::move(features));
 	m_timings.add("track", secondsSince(t0));
-	if (m_cfg.tracker.hoc.enabled)
+	if (m_cfg.tracker.hoc.enabled) m_timings.add("hoc", tf.hocSeconds);
+	// A loop closed on another thread moved the map: the path length restarts from here.
+	if (m_map.corrections() != m_correctionsSeen)
 	{
-		m_timings.add("hoc", tf.hocSeconds);
-		m_stats.landmarksPrunedHoc += tf.hoc.pruned;
-		m_stats.hocIncrements += tf.hoc.incremented;
-		m_stats.hocDecrements += tf.hoc.decremented;
-		m_stats.hocOccluded += tf.hoc.occluded;
-		m_stats.hocRecovered += tf.hoc.recovered;
+		m_correctionsSeen = m_map.corrections();
+		m_lastTrackedPose.reset();
 	}
 	if (tf.tracked)
 	{
 		if (m_lastTrackedPose) m_travelled += (tf.T_world_cam.translation() - m_lastTrackedPose->translation()).norm();
 		m_lastTrackedPose = tf.T_world_cam;
 	}
-	if (tf.newKeyFrame)
+	const KeyFrameJob job{tf.keyframe, tf.index, m_travelled, K};
+	if (tf.newKeyFrame && !m_mappingQueue)
 	{
-		t0 = std::chrono::steady_clock::now();
-		const auto rep = m_mapper.process(tf.keyframe, K);
-		m_timings.add("local_mapping", secondsSince(t0));
-		if (m_maps && m_map.hasKeyFrame(tf.keyframe))
-		{
-			t0 = std::chrono::steady_clock::now();
-			m_maps->insertKeyFrame(m_map, tf.keyframe, m_travelled);
-			m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
-			m_timings.add("map_insertion", secondsSince(t0));
-		}
-		if (m_loopCloser && m_map.hasKeyFrame(tf.keyframe))
-		{
-			t0 = std::chrono::steady_clock::now();
-			auto ev = m_loopCloser->process(tf.keyframe, tf.index, K);
-			m_timings.add("loop_closing", secondsSince(t0));
-			if (ev)
-			{
-				// The frame that created the keyframe is the tracker's last frame.
-				m_tracker.onMapCorrected(m_map.keyframe(tf.keyframe).T_world_cam);
-				tf.T_world_cam = m_map.keyframe(tf.keyframe).T_world_cam;
-				m_lastTrackedPose = tf.T_world_cam;
-				if (m_maps)
-				{
-					for (const auto& [name, sec] : m_maps->applyCorrection(ev->newPoses)) m_timings.add("map_correction:" + name, sec);
-					m_maps->notifyLoopClosure();
-				}
-				m_loops.push_back(std::move(*ev));
-			}
-		}
-		m_stats.keyframesCreated++;
-		m_stats.keyframesCulled += rep.culledKeyFrames;
-		m_stats.landmarksCulled += rep.culledLandmarks;
-		m_stats.landmarksFused += rep.fusedLandmarks;
-		m_stats.sumBaKeyFrames += rep.ba.keyframes;
-		m_stats.sumBaObservations += rep.ba.observations;
-		m_stats.sumBaOutliers += rep.ba.outliersRemoved;
+		mapKeyFrame(job, nullptr);
+		insertAndCloseLoops(job, &tf);
 	}
 	tf.mapLandmarks = m_map.numLandmarks();
-	m_stats.frames++;
-	m_stats.sumInliers += tf.inliers;
-	if (tf.tracked) m_stats.tracked++;
-	else
-		m_stats.lost++;
-	if (tf.method == "relocalization" && tf.tracked) m_stats.relocalizations++;
-	if (tf.method == "pnp" && tf.tracked) m_stats.pnpFallbacks++;
+	lock.unlock();
+	{
+		std::lock_guard<std::mutex> lk(m_statsMutex);
+		m_stats.landmarksPrunedHoc += tf.hoc.pruned;
+		m_stats.hocIncrements += tf.hoc.incremented;
+		m_stats.hocDecrements += tf.hoc.decremented;
+		m_stats.hocOccluded += tf.hoc.occluded;
+		m_stats.hocRecovered += tf.hoc.recovered;
+		m_stats.frames++;
+		m_stats.sumInliers += tf.inliers;
+		if (tf.tracked) m_stats.tracked++;
+		else
+			m_stats.lost++;
+		if (tf.method == "relocalization" && tf.tracked) m_stats.relocalizations++;
+		if (tf.method == "pnp" && tf.tracked) m_stats.pnpFallbacks++;
+	}
+	const bool queueKeyFrame = tf.newKeyFrame && m_mappingQueue;
 	m_frames.push_back(std::move(tf));
+	if (queueKeyFrame && !m_mappingQueue->push(job)) throwIfBackgroundFailed();
 	return m_frames.back();
+}
+
+void System::mapKeyFrame(const KeyFrameJob& job, std::unique_lock<std::mutex>* mapLock)
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	const auto rep = m_mapper.process(job.keyframe, job.K, mapLock);
+	m_timings.add("local_mapping", secondsSince(t0));
+	std::lock_guard<std::mutex> lk(m_statsMutex);
+	m_stats.keyframesCreated++;
+	m_stats.keyframesCulled += rep.culledKeyFrames;
+	m_stats.landmarksCulled += rep.culledLandmarks;
+	m_stats.landmarksFused += rep.fusedLandmarks;
+	m_stats.sumBaKeyFrames += rep.ba.keyframes;
+	m_stats.sumBaObservations += rep.ba.observations;
+	m_stats.sumBaOutliers += rep.ba.outliersRemoved;
+	m_stats.baDiscarded += rep.baDiscarded ? 1 : 0;
+}
+
+void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
+{
+	if (!m_map.hasKeyFrame(job.keyframe)) return;  // culled by local mapping
+	if (m_maps)
+	{
+		const auto t0 = std::chrono::steady_clock::now();
+		m_maps->insertKeyFrame(m_map, job.keyframe, job.travelled);
+		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+		m_timings.add("map_insertion", secondsSince(t0));
+	}
+	if (!m_loopCloser) return;
+	const auto t0 = std::chrono::steady_clock::now();
+	auto ev = m_loopCloser->process(job.keyframe, job.frameIndex, job.K);
+	m_timings.add("loop_closing", secondsSince(t0));
+	if (!ev) return;
+	m_map.noteCorrection();
+	if (tf)
+	{
+		// Sequential: the frame that created the keyframe is the tracker's last frame.
+		m_tracker.onMapCorrected(m_map.keyframe(job.keyframe).T_world_cam);
+		tf->T_world_cam = m_map.keyframe(job.keyframe).T_world_cam;
+		m_lastTrackedPose = tf->T_world_cam;
+		m_correctionsSeen = m_map.corrections();
+	}
+	else
+		m_tracker.onMapCorrected();  // tracking went on: its last frame follows its reference
+	if (m_maps)
+	{
+		for (const auto& [name, sec] : m_maps->applyCorrection(ev->newPoses)) m_timings.add("map_correction:" + name, sec);
+		m_maps->notifyLoopClosure();
+	}
+	std::lock_guard<std::mutex> lk(m_statsMutex);
+	m_loops.push_back(std::move(*ev));
+}
+
+void System::mappingThread()
+{
+	try
+	{
+		while (auto job = m_mappingQueue->pop())
+		{
+			std::unique_lock<std::mutex> lock(m_map.mutex());
+			// A keyframe still queued may have been culled as redundant meanwhile.
+			if (!m_map.hasKeyFrame(job->keyframe)) continue;
+			mapKeyFrame(*job, &lock);
+			lock.unlock();
+			if (!m_loopQueue->push(*job)) break;
+		}
+	}
+	catch (const std::exception& e)
+	{
+		setBackgroundError(std::string("local mapping: ") + e.what());
+	}
+	m_loopQueue->close();
+}
+
+void System::loopClosingThread()
+{
+	try
+	{
+		while (auto job = m_loopQueue->pop())
+		{
+			std::lock_guard<std::mutex> lock(m_map.mutex());
+			insertAndCloseLoops(*job, nullptr);
+		}
+	}
+	catch (const std::exception& e)
+	{
+		setBackgroundError(std::string("loop closing: ") + e.what());
+	}
+}
+
+void System::setBackgroundError(const std::string& what)
+{
+	{
+		std::lock_guard<std::mutex> lk(m_statsMutex);
+		if (m_backgroundError.empty()) m_backgroundError = what;
+	}
+	// Nothing more is accepted: tracking's next push fails and reports the error.
+	m_mappingQueue->close();
+	m_loopQueue->close();
+}
+
+void System::throwIfBackgroundFailed() const
+{
+	const std::string e = backgroundError();
+	if (!e.empty()) throw std::runtime_error(e);
+}
+
+std::string System::backgroundError() const
+{
+	std::lock_guard<std::mutex> lk(m_statsMutex);
+	return m_backgroundError;
+}
+
+SystemStats System::stats() const
+{
+	std::lock_guard<std::mutex> lk(m_statsMutex);
+	return m_stats;
+}
+
+std::size_t System::numKeyFrames() const
+{
+	std::lock_guard<std::mutex> lk(m_map.mutex());
+	return m_map.numKeyFrames();
+}
+
+void System::joinThreads()
+{
+	if (!m_mappingQueue) return;
+	m_mappingQueue->close();  // the queued keyframes are still mapped, then loop-closed
+	if (m_mapping.joinable()) m_mapping.join();
+	if (m_loopClosing.joinable()) m_loopClosing.join();
 }
 
 void System::finish()
 {
+	joinThreads();
 	if (m_finished || !m_K || m_map.numKeyFrames() == 0) return;
 	m_finished = true;
 	const auto t0 = std::chrono::steady_clock::now();

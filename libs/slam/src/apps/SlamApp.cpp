@@ -107,9 +107,10 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	auto report = [&](const sfm::TrackedFrame& tf) {
 		const double el = since(tStart);
 		char extra[128];
-		std::snprintf(extra, sizeof(extra), "%.1f fps, kf %zu, lost %zu%s", sys.stats().frames / std::max(el, 1e-9),
-					  sys.map().numKeyFrames(), sys.stats().lost, tf.tracked ? "" : " (LOST)");
-		bar.update(sys.stats().frames, extra);
+		const auto st = sys.stats();
+		std::snprintf(extra, sizeof(extra), "%.1f fps, kf %zu, lost %zu%s", st.frames / std::max(el, 1e-9),
+					  sys.numKeyFrames(), st.lost, tf.tracked ? "" : " (LOST)");
+		bar.update(st.frames, extra);
 	};
 	auto limitReached = [&](std::size_t n) { return o.maxFrames && n >= o.maxFrames; };
 
@@ -200,6 +201,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (res.interrupted && !o.quiet)
 		std::cerr << "keygrid-slam: interrupted after " << sys.stats().frames << " frames, writing the outputs\n";
 	sys.finish();
+	if (res.error.empty()) res.error = sys.backgroundError();
 	const double wall = since(tStart);
 
 	const auto traj = sys.trajectory();
@@ -241,6 +243,30 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		if (res.error.empty()) res.error = std::string("writing scene.3Dscene: ") + e.what();
 	}
 
+	if (sys.loopCloser())
+	{
+		// Why each keyframe did or did not close a loop (doc/loop-closure.md, "Diagnostics").
+		std::ostringstream csv;
+		csv << "keyframe,frame,outcome,reference_score,candidates,best_candidate,best_score,verified_candidate,matches,inliers,query_ms\n";
+		for (const auto& q : sys.loopCloser()->queries())
+		{
+			char line[256];
+			std::snprintf(line, sizeof(line), "%llu,%zu,%s,%.4f,%d,%s,%.4f,%s,%d,%d,%.3f\n", static_cast<unsigned long long>(q.keyframe),
+						  q.frameIndex, q.outcome.c_str(), q.referenceScore, q.candidates,
+						  q.candidates ? std::to_string(q.bestCandidate).c_str() : "", q.bestScore,
+						  q.verifiedCandidate ? std::to_string(*q.verifiedCandidate).c_str() : "", q.matches, q.inliers,
+						  1e3 * q.querySeconds);
+			csv << line;
+		}
+		try
+		{
+			writeFileAtomically(o.output + "/loop_queries.csv", csv.str());
+		}
+		catch (const std::exception& e)
+		{
+			if (res.error.empty()) res.error = std::string("writing loop_queries.csv: ") + e.what();
+		}
+	}
 	if (sys.loopCloser() && sys.loopCloser()->lastPoseGraph())
 	{
 		try
@@ -328,6 +354,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "  \"landmarks\": " << sys.map().numLandmarks() << ",\n";
 	js << "  \"landmarks_culled\": " << st.landmarksCulled << ",\n";
 	js << "  \"landmarks_fused\": " << st.landmarksFused << ",\n";
+	if (cfg.mode == "threaded") js << "  \"ba_discarded\": " << st.baDiscarded << ",\n";
 	if (cfg.tracker.hoc.enabled)
 		js << "  \"hoc\": {\"landmarks_pruned\": " << st.landmarksPrunedHoc << ", \"increments\": " << st.hocIncrements
 		   << ", \"decrements\": " << st.hocDecrements << ", \"occluded\": " << st.hocOccluded << ", \"recovered\": " << st.hocRecovered << "},\n";

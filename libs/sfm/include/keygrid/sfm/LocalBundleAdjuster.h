@@ -8,6 +8,7 @@
 #include <keygrid/sfm/PoseOptimizer.h>
 #include <keygrid/sfm/SparseMap.h>
 
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
@@ -65,6 +66,33 @@ struct BundleAdjusterReport
 	double initialCost{0}, finalCost{0};
 };
 
+/** One bundle adjustment in three steps, so that threaded mode can solve without holding the
+ * map lock: the constructor copies poses, points and measurements out of the map (lock held),
+ * solve() touches only those copies, apply() writes the result back to whatever is still in
+ * the map and drops the observations that remain outliers (lock held). */
+class BundleAdjustment
+{
+   public:
+	/** Keyframes `local` move, `fixed` ones only anchor; all landmarks seen by `local` move.
+	 * The first keyframe of the map never moves (it defines the world frame). */
+	BundleAdjustment(
+		const SparseMap& map, const std::vector<KeyFrameId>& local, const std::set<KeyFrameId>& fixed,
+		const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);
+	/** The local window of `kf`: it and its best covisibles move, the keyframes that share
+	 * most of their landmarks stay fixed. */
+	static BundleAdjustment around(
+		const SparseMap& map, KeyFrameId kf, const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);
+	BundleAdjustment(BundleAdjustment&&) noexcept;
+	~BundleAdjustment();
+
+	void solve();
+	BundleAdjusterReport apply(SparseMap& map);
+
+   private:
+	struct Problem;
+	std::unique_ptr<Problem> m;
+};
+
 /** Optimises the window around `kf` in place and removes outlier observations. */
 BundleAdjusterReport localBundleAdjustment(
 	SparseMap& map, KeyFrameId kf, const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);
@@ -73,8 +101,7 @@ BundleAdjusterReport localBundleAdjustment(
 BundleAdjusterReport globalBundleAdjustment(
 	SparseMap& map, const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);
 
-/** The shared core: keyframes `local` move, `fixed` ones only anchor; all landmarks seen by
- * `local` move. */
+/** BundleAdjustment(map, local, fixed, ...) solved and applied. */
 BundleAdjusterReport bundleAdjust(
 	SparseMap& map, const std::vector<KeyFrameId>& local, const std::set<KeyFrameId>& fixed,
 	const PinholeIntrinsics& K, const BundleAdjusterOptions& opts);

@@ -9,6 +9,7 @@
 #include <keygrid/sfm/SparseMap.h>
 
 #include <deque>
+#include <mutex>
 #include <string>
 
 namespace mrpt::config
@@ -48,6 +49,9 @@ struct LocalMappingReport
 {
 	int culledLandmarks{0}, fusedLandmarks{0}, addedObservations{0}, culledKeyFrames{0}, triangulated{0};
 	BundleAdjusterReport ba;
+	/** Threaded mode: the bundle adjustment was solved, but a loop closure corrected the map
+	 * meanwhile, so its result was dropped. */
+	bool baDiscarded{false};
 };
 
 class LocalMapper
@@ -55,9 +59,10 @@ class LocalMapper
    public:
 	LocalMapper(SparseMap& map, const LocalMapperOptions& opts, const MatcherOptions& matcher);
 
-	/** Processes a keyframe just created by the Tracker. In threaded mode the caller holds
-	 * map.mutex(). */
-	LocalMappingReport process(KeyFrameId kf, const PinholeIntrinsics& K);
+	/** Processes a keyframe just created by the Tracker. In threaded mode the caller passes
+	 * its lock on map.mutex() (held on entry and on return): the bundle adjustment is then
+	 * solved with the lock released, so tracking goes on meanwhile. */
+	LocalMappingReport process(KeyFrameId kf, const PinholeIntrinsics& K, std::unique_lock<std::mutex>* mapLock = nullptr);
 
 	/** Projects landmarks `lms` into keyframe `target`, merging duplicates and adding missing
 	 * observations (used after a loop closure to join both sides of the loop). Returns the

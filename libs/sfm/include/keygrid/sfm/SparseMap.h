@@ -103,8 +103,14 @@ class SparseMap
 	std::size_t numKeyFrames() const { return m_keyframes.size(); }
 	std::size_t numLandmarks() const { return m_landmarks.size(); }
 
-	/** The map's own lock, for threaded mode (tracking and mapping on separate threads). */
+	/** The map's own lock, for threaded mode (tracking, mapping and loop closing on separate
+	 * threads; see slam::System). */
 	std::mutex& mutex() const { return m_mutex; }
+	/** Counts corrections that moved the whole map (loop closures). A result computed from an
+	 * older state, e.g. a bundle adjustment solved without the lock, must not be written back
+	 * across one. */
+	std::uint64_t corrections() const { return m_corrections; }
+	void noteCorrection() { ++m_corrections; }
 
    private:
 	std::map<KeyFrameId, KeyFrame> m_keyframes;
@@ -113,6 +119,7 @@ class SparseMap
 	std::map<KeyFrameId, std::pair<KeyFrameId, mrpt::poses::CPose3D>> m_erased;
 	KeyFrameId m_nextKf{0};
 	LandmarkId m_nextLm{0};
+	std::uint64_t m_corrections{0};
 	mutable std::mutex m_mutex;
 };
 

@@ -68,13 +68,17 @@ class Tracker
 	void setPlaceRecognizer(PlaceRecognizer f) { m_placeRecognizer = std::move(f); }
 
 	/** Tracks one frame whose features were extracted by the caller. In threaded mode the
-	 * caller holds map.mutex() around this call. */
+	 * caller holds map.mutex() around this call (and around every other call). */
 	TrackedFrame track(const core::Frame& frame, FrameFeatures features);
 
 	TrackingState state() const { return m_state; }
 	/** After a map correction (loop closure) moved the last tracked frame: its new pose. The
 	 * motion model (relative) stays valid. */
 	void onMapCorrected(const mrpt::poses::CPose3D& T_world_lastFrame) { m_lastPose = T_world_lastFrame; }
+	/** After a map correction, when the last frame's new pose is not known (threaded mode:
+	 * tracking went on while the loop was closed): the last frame follows its reference
+	 * keyframe. */
+	void onMapCorrected();
 	const TrackerOptions& options() const { return m_opts; }
 	/** Landmarks matched as inliers in the last frame (for diagnostics and the maps). */
 	const std::vector<LandmarkId>& lastInlierLandmarks() const { return m_lastInliers; }
@@ -124,6 +128,8 @@ class Tracker
 	mrpt::poses::CPose3D m_lastPose;
 	std::optional<mrpt::poses::CPose3D> m_velocity;  //!< T_last_cur of the last tracked step
 	KeyFrameId m_refKf{0};
+	/** The last frame's reference keyframe and its pose relative to it. */
+	std::optional<std::pair<KeyFrameId, mrpt::poses::CPose3D>> m_lastRelative;
 	std::size_t m_lastKfFrame{0};
 	std::vector<KeyFrameId> m_localKfs;
 	std::vector<LandmarkId> m_lastInliers;

@@ -69,6 +69,30 @@ struct LoopClosureEvent
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> newPoses;
 };
 
+/** What loop detection made of one keyframe (keygrid-slam writes them to loop_queries.csv):
+ * why a loop was or was not closed there. */
+struct LoopQueryRecord
+{
+	sfm::KeyFrameId keyframe{0};
+	std::size_t frameIndex{0};
+	/** "closed", or why not: "no_vocabulary" (in-run training not done yet), "after_loop"
+	 * (detection paused right after a loop), "no_candidate" (nothing above the covisible
+	 * keyframes' score), "not_consistent" (no candidate group seen in enough consecutive
+	 * keyframes), "few_matches" / "ransac_failed" (geometric verification), "implausible"
+	 * (correction larger than drift explains), "pose_graph_failed" */
+	std::string outcome;
+	/** The lowest BoW score between the keyframe and its covisible keyframes */
+	double referenceScore{0};
+	int candidates{0};  //!< database candidates above that reference
+	sfm::KeyFrameId bestCandidate{0};  //!< valid when candidates > 0
+	double bestScore{0};
+	/** The candidate that passed the consistency check and went to verification */
+	std::optional<sfm::KeyFrameId> verifiedCandidate;
+	/** Verification: descriptor matches with depth on both sides, RANSAC inliers */
+	int matches{0}, inliers{0};
+	double querySeconds{0};  //!< BoW transform + database query [s]
+};
+
 class LoopCloser
 {
    public:
@@ -89,15 +113,22 @@ class LoopCloser
 
 	bool hasVocabulary() const { return !m_vocab.empty(); }
 	const loop::Vocabulary& vocabulary() const { return m_vocab; }
+	/** One record per keyframe handled by process(), in order. */
+	const std::vector<LoopQueryRecord>& queries() const { return m_queries; }
 	/** The keyframe pose graph of the last correction (for posegraph.g2o). */
 	const std::optional<loop::PoseGraph>& lastPoseGraph() const { return m_lastGraph; }
 
    private:
 	void trainIfReady();
-	std::optional<sfm::KeyFrameId> detect(sfm::KeyFrameId kf, const loop::BowVector& bow, double& score);
+	/** The consistent candidate, if any; fills rec's candidate fields. */
+	std::optional<sfm::KeyFrameId> detect(sfm::KeyFrameId kf, const loop::BowVector& bow, double& score, LoopQueryRecord& rec);
 	/** False when the loop measurement disagrees with the estimate more than drift can explain. */
 	bool plausible(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur) const;
-	bool verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, int& inliers);
+	bool verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, LoopQueryRecord& rec);
+	/** Plausibility check, pose-graph correction and the event; rec.outcome says which. */
+	std::optional<LoopClosureEvent> closeVerifiedLoop(
+		sfm::KeyFrameId kf, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, std::size_t frameIndex,
+		double score, const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec);
 	LoopClosureEvent correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K);
 
 	sfm::SparseMap& m_map;
@@ -112,6 +143,7 @@ class LoopCloser
 	std::optional<loop::PoseGraph> m_lastGraph;
 	sfm::KeyFrameId m_lastLoopKf{0};
 	bool m_anyLoop{false};
+	std::vector<LoopQueryRecord> m_queries;
 
    public:
 	/** Loops that passed verification but were rejected as implausible (diagnostics). */

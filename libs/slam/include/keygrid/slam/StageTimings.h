@@ -1,9 +1,11 @@
 #pragma once
 /** \file StageTimings.h
  * Per-stage durations of the pipeline (load, extract, track, mapping, ...), summarised as
- * median and 95th percentile for report.json.
+ * median and 95th percentile for report.json. Thread-safe: in threaded mode tracking, mapping
+ * and loop closing add their samples from their own threads.
  */
 #include <map>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -12,7 +14,11 @@ namespace keygrid::slam
 class StageTimings
 {
    public:
-	void add(const std::string& stage, double seconds) { m_samples[stage].push_back(seconds); }
+	void add(const std::string& stage, double seconds)
+	{
+		std::lock_guard<std::mutex> lk(m_mutex);
+		m_samples[stage].push_back(seconds);
+	}
 
 	struct Summary
 	{
@@ -25,7 +31,8 @@ class StageTimings
 	std::string toJson(int indent = 2) const;
 
    private:
-	std::map<std::string, std::vector<double>> m_samples;
+	mutable std::mutex m_mutex;
+	std::map<std::string, std::vector<double>> m_samples;  //!< guarded by m_mutex
 };
 
 }  // namespace keygrid::slam

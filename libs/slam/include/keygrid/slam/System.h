@@ -3,8 +3,15 @@
  * The SLAM pipeline for one sequence: feature extraction, tracking and local mapping over a
  * shared sparse map, with the per-frame record from which the final trajectory is built.
  *
- * Sequential use: process(frame) for each frame (deterministic). Pipelined use: extract()
- * may run on another thread (it touches no shared state), then processExtracted() in order.
+ * Sequential mode ([slam] mode = sequential): process(frame) for each frame; tracking, local
+ * mapping, map insertion and loop closing run in turn on the calling thread (deterministic).
+ *
+ * Threaded mode: extract() may run on another thread (it touches no shared state), then
+ * processExtracted() in order; it tracks on the calling thread and hands new keyframes to a
+ * local-mapping thread, which hands them on to a loop-closing thread (map insertion, loop
+ * detection and correction), joined by typed bounded queues. The sparse map is guarded by
+ * its mutex: tracking holds it per frame, local mapping releases it while its bundle
+ * adjustment is solved, loop closing holds it per keyframe. finish() drains and joins.
  */
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/sfm/LocalMapper.h>
@@ -14,8 +21,13 @@
 #include <keygrid/slam/SlamConfig.h>
 #include <keygrid/slam/StageTimings.h>
 
+#include <keygrid/core/BoundedQueue.h>
+
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <string>
+#include <thread>
 #include <vector>
 
 namespace keygrid::slam
@@ -27,12 +39,20 @@ struct SystemStats
 	/** HOC: landmarks erased by pruning, and the bin updates of all frames. */
 	std::size_t landmarksPrunedHoc{0}, hocIncrements{0}, hocDecrements{0}, hocOccluded{0}, hocRecovered{0};
 	double sumInliers{0}, sumBaKeyFrames{0}, sumBaObservations{0}, sumBaOutliers{0};
+	/** Threaded mode: local bundle adjustments dropped because a loop closure moved the map
+	 * while they were solved. */
+	std::size_t baDiscarded{0};
 };
 
 class System
 {
    public:
+	/** Starts the mapping and loop-closing threads when cfg.mode is "threaded". */
 	explicit System(const SlamConfig& cfg);
+	/** Stops and joins the threads (what they had queued is still processed). */
+	~System();
+	System(const System&) = delete;
+	System& operator=(const System&) = delete;
 
 	/** Features of a frame (thread-compatible: no shared state touched). */
 	sfm::FrameFeatures extract(const core::Frame& frame) const;
@@ -45,8 +65,9 @@ class System
 	void attachMaps(std::unique_ptr<MetricMaps> maps) { m_maps = std::move(maps); }
 	const MetricMaps* metricMaps() const { return m_maps.get(); }
 
-	/** After the last frame: global bundle adjustment and frame re-estimation, as configured
-	 * in [refinement]. Idempotent. */
+	/** After the last frame: waits for the mapping and loop-closing threads to process every
+	 * queued keyframe, then global bundle adjustment and frame re-estimation, as configured in
+	 * [refinement]. Idempotent. */
 	void finish();
 
 	/** Every processed frame's pose: re-estimated against the final map when finish() did so,
@@ -55,16 +76,46 @@ class System
 	/** Poses of the keyframes in the map. */
 	core::Trajectory keyframeTrajectory() const;
 
+	/** The map; in threaded mode only after finish() (while the threads run, use
+	 * numKeyFrames()). */
 	const sfm::SparseMap& map() const { return m_map; }
+	/** Keyframes in the map now (takes the map lock: safe while the threads run). */
+	std::size_t numKeyFrames() const;
 	const std::vector<sfm::TrackedFrame>& frames() const { return m_frames; }
-	const SystemStats& stats() const { return m_stats; }
+	/** A snapshot of the counters (several threads update them in threaded mode). */
+	SystemStats stats() const;
+	/** In threaded mode only after finish(). */
 	const std::vector<LoopClosureEvent>& loopClosures() const { return m_loops; }
+	/** Threaded mode: what stopped the mapping or loop-closing thread (empty if nothing did).
+	 * processExtracted() throws it; after finish() it is kept here. */
+	std::string backgroundError() const;
 	const LoopCloser* loopCloser() const { return m_loopCloser.get(); }
 	StageTimings& timings() { return m_timings; }
 	const StageTimings& timings() const { return m_timings; }
 	const SlamConfig& config() const { return m_cfg; }
 
    private:
+	/** A new keyframe on its way through local mapping and loop closing. */
+	struct KeyFrameJob
+	{
+		sfm::KeyFrameId keyframe{0};
+		std::size_t frameIndex{0};  //!< the frame that created it
+		double travelled{0};  //!< camera path length up to that frame [m]
+		sfm::PinholeIntrinsics K;
+	};
+	/** Local mapping of a new keyframe; the map lock is held (mapLock: released while the
+	 * bundle adjustment is solved). */
+	void mapKeyFrame(const KeyFrameJob& job, std::unique_lock<std::mutex>* mapLock);
+	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
+	 * tracker's last frame, which created the keyframe. */
+	void insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
+	void mappingThread();
+	void loopClosingThread();
+	void setBackgroundError(const std::string& what);
+	void throwIfBackgroundFailed() const;
+	/** Closes the mapping queue and joins both threads. */
+	void joinThreads();
+
 	SlamConfig m_cfg;
 	sfm::FeatureExtractor m_extractor;
 	sfm::SparseMap m_map;
@@ -79,8 +130,15 @@ class System
 	std::vector<LoopClosureEvent> m_loops;
 	double m_travelled{0};
 	std::optional<mrpt::poses::CPose3D> m_lastTrackedPose;
+	/** m_map.corrections() when the tracking side last re-based its travelled distance. */
+	std::uint64_t m_correctionsSeen{0};
+	mutable std::mutex m_statsMutex;  //!< guards m_stats, m_loops, m_backgroundError
 	SystemStats m_stats;
 	StageTimings m_timings;
+	std::string m_backgroundError;
+	// Threaded mode.
+	std::unique_ptr<core::BoundedQueue<KeyFrameJob>> m_mappingQueue, m_loopQueue;
+	std::thread m_mapping, m_loopClosing;
 };
 
 }  // namespace keygrid::slam
