@@ -87,6 +87,7 @@ TEST(CHOCPointsMap, SerializationRoundTripKeepsPointsDescriptorsAndHistograms)
 	keygrid::maps::HocOptions o;
 	o.radii = {0.7, 3.0};
 	o.countLimit = 7;
+	o.decrementNeedsKeypoint = true;  // not the default: checks that version 1 stores it
 	CHOCPointsMap m(o);
 	std::vector<CHOCPointsMap::Point> pts;
 	for (int i = 0; i < 50; i++)
@@ -108,6 +109,7 @@ TEST(CHOCPointsMap, SerializationRoundTripKeepsPointsDescriptorsAndHistograms)
 	ASSERT_EQ(back.size(), 50u);
 	EXPECT_EQ(back.hocOptions.radii, o.radii);
 	EXPECT_EQ(back.hocOptions.countLimit, 7);
+	EXPECT_TRUE(back.hocOptions.decrementNeedsKeypoint);
 	for (std::size_t i = 0; i < 50; i++)
 	{
 		EXPECT_EQ(back.points()[i].id, pts[i].id);

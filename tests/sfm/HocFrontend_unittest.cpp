@@ -95,3 +95,53 @@ TEST(HocFrontend, OcclusionToleranceGrowsWithDepth)
 	EXPECT_FALSE(hoc.occluded(depth, 5, 5, 2.2f));
 	EXPECT_FALSE(hoc.occluded(depth, 50, 5, 2.2f));  // outside the image
 }
+
+TEST(HocFrontend, MissCountsOnlyWithKeypointInSearchWindowWhenRequired)
+{
+	// Three landmarks in view, none matched, their surfaces measured at the predicted depth:
+	//  lm0: a keypoint 1 px away at the predicted level (searched, did not match) -> -1;
+	//  lm1: the nearest keypoint 10 px away, outside the 4 px window -> nothing detected there;
+	//  lm2: a keypoint at its pixel but 3 levels above the predicted one (outside level +-1).
+	// The standard rule decrements (and prunes) all three; with decrement_needs_keypoint only lm0.
+	for (const bool needKeypoint : {false, true})
+	{
+		SCOPED_TRACE(needKeypoint ? "decrement_needs_keypoint" : "every miss");
+		keygrid::maps::HocOptions o;
+		o.enabled = true;
+		o.pruneThreshold = 0.6;  // prune when max n <= 0
+		o.decrementNeedsKeypoint = needKeypoint;
+		const HocFrontend hoc(o);
+		SparseMap map;
+		const auto kf = map.addKeyFrame(makeKf(3)).id;
+		std::vector<LandmarkId> lm;
+		for (int i = 0; i < 3; i++) lm.push_back(map.addLandmark({0.3 + 0.01 * i, 0.2, 2.0}, kf, i));
+		FrameFeatures f = makeKf(3).features;
+		f.levelScale = {1.0, 1.2, 1.44, 1.728};
+		f.undistorted = {{201.f, 200.f}, {410.f, 300.f}, {300.f, 100.f}};
+		for (std::size_t i = 0; i < 3; i++) f.keypoints[i] = cv::KeyPoint(f.undistorted[i], 31.f, -1, 0, i == 2 ? 3 : 0);
+		f.buildGrid();
+		std::vector<ProjectedLandmark> visible{projected(lm[0], 200, 200, 2.0f), projected(lm[1], 400, 300, 2.0f), projected(lm[2], 300, 100, 2.0f)};
+		EXPECT_TRUE(HocFrontend::keypointInWindow(f, visible[0], 4.f));
+		EXPECT_FALSE(HocFrontend::keypointInWindow(f, visible[1], 4.f));
+		EXPECT_FALSE(HocFrontend::keypointInWindow(f, visible[2], 4.f));
+		EXPECT_TRUE(HocFrontend::keypointInWindow(f, visible[1], 12.f));  // 10 px away
+		const cv::Mat depth(480, 640, CV_32F, cv::Scalar(2.0f));
+		const Eigen::Vector3d c(0, 0, 0);
+		const int b = hoc.geometry().bin(map.landmark(lm[0]).p_world, c);
+		const auto st = hoc.update(map, f, std::vector<LandmarkId>(3, kNoLandmark), visible, {}, depth, c, 4.f, MatcherOptions());
+		EXPECT_EQ(st.incremented, 0);
+		EXPECT_EQ(st.occluded, 0);
+		EXPECT_EQ(st.decremented, needKeypoint ? 1 : 3);
+		EXPECT_EQ(st.undetected, needKeypoint ? 2 : 0);
+		EXPECT_EQ(st.pruned, needKeypoint ? 1 : 3);  // +1 seed - 1 = 0: max weight 0.5 < 0.6
+		EXPECT_FALSE(map.hasLandmark(lm[0]));
+		for (int i : {1, 2})
+		{
+			ASSERT_EQ(map.hasLandmark(lm[i]), needKeypoint);
+			if (needKeypoint)
+			{
+				EXPECT_EQ(map.landmark(lm[i]).hoc.count(b), 1);
+			}
+		}
+	}
+}

@@ -32,7 +32,9 @@ int positiveObservations(const maps::HocHistogram& h)
 }
 }  // namespace
 
-uint8_t CHOCPointsMap::serializeGetVersion() const { return 0; }
+// Version 1 adds HocOptions::decrementNeedsKeypoint after the other options; version 0 streams
+// read it as false (the behaviour they were written with).
+uint8_t CHOCPointsMap::serializeGetVersion() const { return 1; }
 
 void CHOCPointsMap::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -41,6 +43,7 @@ void CHOCPointsMap::serializeTo(mrpt::serialization::CArchive& out) const
 	for (double r : o.radii) out << r;
 	out << int32_t(o.subdivisions) << o.sigmoidGain << o.sigmoidOffset << o.selectThreshold << o.pruneThreshold
 		<< int32_t(o.countLimit) << int32_t(o.initialCount) << o.occlusionToleranceAbs << o.occlusionToleranceRel << o.visibleDepthMin << o.visibleDepthMax;
+	out << o.decrementNeedsKeypoint;
 	out << int32_t(insertionOptions.decimation) << insertionOptions.pointSpacing << insertionOptions.prune;
 	out << int32_t(likelihoodOptions.decimation) << likelihoodOptions.sigma << likelihoodOptions.outlierProbability;
 	out << m_nextId << uint64_t(m_points.size());
@@ -57,7 +60,7 @@ void CHOCPointsMap::serializeTo(mrpt::serialization::CArchive& out) const
 
 void CHOCPointsMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t version)
 {
-	if (version != 0) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
+	if (version > 1) MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);
 	maps::HocOptions o;
 	uint32_t nr = 0;
 	in >> o.enabled >> nr;
@@ -67,6 +70,7 @@ void CHOCPointsMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t ver
 	int32_t sub = 0, lim = 0, init = 0, idec = 0, ldec = 0;
 	in >> sub >> o.sigmoidGain >> o.sigmoidOffset >> o.selectThreshold >> o.pruneThreshold >> lim >> init >> o.occlusionToleranceAbs >>
 		o.occlusionToleranceRel >> o.visibleDepthMin >> o.visibleDepthMax;
+	if (version >= 1) in >> o.decrementNeedsKeypoint;
 	o.subdivisions = sub;
 	o.countLimit = lim;
 	o.initialCount = init;

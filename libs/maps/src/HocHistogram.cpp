@@ -64,6 +64,7 @@ void HocOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, cons
 	occlusionToleranceRel = detail::readNumber(c, s, "occlusion_tolerance_rel", occlusionToleranceRel);
 	visibleDepthMin = detail::readNumber(c, s, "visible_depth_min", visibleDepthMin);
 	visibleDepthMax = detail::readNumber(c, s, "visible_depth_max", visibleDepthMax);
+	decrementNeedsKeypoint = detail::readBool(c, s, "decrement_needs_keypoint", decrementNeedsKeypoint);
 	try
 	{
 		validate();
@@ -91,6 +92,8 @@ void HocOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::s
 	c.write(s, "occlusion_tolerance_rel", occlusionToleranceRel, 30, 40, "see occlusion_tolerance_abs");
 	c.write(s, "visible_depth_min", visibleDepthMin, 30, 40, "[m] points nearer than this are not expected to be seen");
 	c.write(s, "visible_depth_max", visibleDepthMax, 30, 40, "[m] points farther than this are not expected to be seen");
+	c.write(s, "decrement_needs_keypoint", decrementNeedsKeypoint ? "true" : "false", 30, 40,
+			"count a miss only when a keypoint was detected in the point's search window");
 }
 
 void HocHistogram::add(int bin, int delta, int limit, int numBins)

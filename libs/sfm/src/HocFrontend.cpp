@@ -3,6 +3,7 @@
  */
 #include <keygrid/sfm/HocFrontend.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -37,6 +38,12 @@ bool HocFrontend::hasDepth(const cv::Mat& depth, float u, float v)
 	if (depth.empty() || x < 0 || y < 0 || x >= depth.cols || y >= depth.rows) return false;
 	const float d = depth.at<float>(y, x);
 	return std::isfinite(d) && d > 0;
+}
+
+bool HocFrontend::keypointInWindow(const FrameFeatures& f, const ProjectedLandmark& p, float radius)
+{
+	const float r = radius * static_cast<float>(f.levelScale.empty() ? 1.0 : f.levelScale[p.predictedLevel]);
+	return !f.featuresInArea(p.u, p.v, r, std::max(0, p.predictedLevel - 1), p.predictedLevel + 1).empty();
 }
 
 bool HocFrontend::occluded(const cv::Mat& depth, float u, float v, float predicted) const
@@ -89,6 +96,18 @@ HocUpdateStats HocFrontend::update(
 		if (occluded(depth, p.u, p.v, p.depth))
 		{
 			st.occluded++;
+			return;
+		}
+		// "Should have been seen" also needs the detector to have fired where the point was
+		// searched for. A static point is matched in a frame with probability q (ORB: about
+		// 0.5); with +1 per match and -1 per miss its n drifts by q - (1 - q) = 2q - 1 per
+		// frame, i.e. down when q < 1/2, although nothing changed. A miss with no keypoint in
+		// the window is about as likely for a present point as for a vanished one (likelihood
+		// ratio ~1: no evidence), so it is not counted; a miss with keypoints there that none
+		// matched is counted.
+		if (m_opts.decrementNeedsKeypoint && !keypointInWindow(f, p, searchRadius))
+		{
+			st.undetected++;
 			return;
 		}
 		bump(lm, -1);

@@ -4,8 +4,10 @@
  *
  * Update rule: a bin (see HocGeometry) holds an integer n, n += 1 when the point was matched by
  * a camera in that bin, n -= 1 when it should have been seen from there (projects into the
- * image, inside the depth range, not occluded according to the depth image) but was not; n is
- * clamped to [-count_limit, count_limit] so that a point whose object re-appears can recover.
+ * image, inside the depth range, not occluded according to the depth image) but was not
+ * (optionally only when the feature detector found a keypoint where the point was searched
+ * for, see decrementNeedsKeypoint); n is clamped to [-count_limit, count_limit] so that a
+ * point whose object re-appears can recover.
  * Weight of a bin: p(n) = 1 / (1 + exp(-gain * (n - offset))), monotone in n, so the maximum
  * weight of a point is p(max_bins n). A bin never observed has n = 0.
  * Use: a point takes part in data association and pose estimation from a camera in bin b only
@@ -48,6 +50,15 @@ struct HocOptions : public mrpt::config::CLoadableOptions
 	/** Depth range in which a point is expected to be seen [m]; keep the maximum inside the
 	 * sensor's range (Default: 0.3 .. 4.0) */
 	double visibleDepthMin{0.3}, visibleDepthMax{4.0};
+	/** Count a miss (n -= 1) only when the frame has a keypoint in the landmark's search window
+	 * (the area and pyramid levels the projection matcher compares it with). A miss without any
+	 * keypoint there says nothing about the point: a static point is re-detected in only about
+	 * half of the frames (blur, contrast, the per-cell feature budget), and counting those
+	 * misses makes n drift down by 2q - 1 per frame for a point matched with probability q < 1/2.
+	 * true keeps static maps accurate but prunes less (larger maps); see doc/hoc.md. Used by
+	 * the tracker (keygrid::sfm::HocFrontend); CHOCPointsMap's depth-scan insertion has no
+	 * keypoints and ignores it (Default: false) */
+	bool decrementNeedsKeypoint{false};
 
 	/** Bin weight p(n). */
 	double weight(int n) const;

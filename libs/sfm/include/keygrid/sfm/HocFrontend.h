@@ -8,8 +8,11 @@
  *    +1 in the camera's bin; landmarks of the local map that project into the image within the
  *    visible depth range, are not occluded according to the depth image (no closer surface
  *    measured at their pixel; a pixel without depth reading does not occlude: an occluder would
- *    be nearer than the point, hence in range), and were not matched get -1. Landmarks that were excluded by the selection are still searched for (without
- *    entering the pose) so that an object that re-appears earns its points back;
+ *    be nearer than the point, hence in range), and were not matched get -1 (with
+ *    decrement_needs_keypoint: only when the frame has a keypoint in the landmark's search
+ *    window; otherwise the miss carries no information and n is left alone). Landmarks that
+ *    were excluded by the selection are still searched for (without entering the pose) so
+ *    that an object that re-appears earns its points back;
  *  - pruning: a landmark whose largest bin weight falls below prune_threshold is erased.
  * A landmark's histogram starts with +1 in the bin of every keyframe that observes it.
  */
@@ -26,6 +29,9 @@ namespace keygrid::sfm
 struct HocUpdateStats
 {
 	int incremented{0}, decremented{0}, occluded{0}, recovered{0}, pruned{0};
+	/** Misses not counted because no keypoint was detected in the search window
+	 * (decrement_needs_keypoint). */
+	int undetected{0};
 };
 
 class HocFrontend
@@ -56,6 +62,9 @@ class HocFrontend
 	/** True when the depth image shows a surface in front of the predicted depth at (u, v)
 	 * (the point is hidden); false also when there is no valid depth there. */
 	bool occluded(const cv::Mat& depth, float u, float v, float predictedDepth) const;
+	/** True when f has a keypoint in p's search window: within radius * scale(level) of the
+	 * projection at the predicted level +-1, the keypoints searchByProjection compares. */
+	static bool keypointInWindow(const FrameFeatures& f, const ProjectedLandmark& p, float radius);
 	/** True when the depth image has a valid value at (u, v). */
 	static bool hasDepth(const cv::Mat& depth, float u, float v);
 
