@@ -3,6 +3,7 @@
 #include <keygrid/sfm/PoseOptimizer.h>
 
 #include <ceres/ceres.h>
+#include <cmath>
 #include <random>
 
 #include "TestData.h"
@@ -108,7 +109,7 @@ TEST(PnpSolver, RecoversKnownPoseDespiteOutliers)
 
 TEST(RgbdReprojectionCost, AutoDiffJacobianMatchesFiniteDifferences)
 {
-	RgbdReprojectionCost cost({300.0, 200.0}, 1.7, 40.0, 1.0 / 1.2, K);
+	RgbdReprojectionCost cost({300.0, 200.0}, 1.7, 40.0, 1.0 / 1.2, 4.0, K);
 	auto* ad = new ceres::AutoDiffCostFunction<RgbdReprojectionCost, 3, 4, 3, 3>(new RgbdReprojectionCost(cost));
 	auto* nd = new ceres::NumericDiffCostFunction<RgbdReprojectionCost, ceres::CENTRAL, 3, 4, 3, 3>(new RgbdReprojectionCost(cost));
 	Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()));
@@ -125,10 +126,22 @@ TEST(RgbdReprojectionCost, AutoDiffJacobianMatchesFiniteDifferences)
 	// The third residual is the virtual-stereo (inverse depth) term: zero at the true depth.
 	Eigen::Vector3d pc = q * Eigen::Vector3d(p[0], p[1], p[2]) + Eigen::Vector3d(t[0], t[1], t[2]);
 	const double u = K.fx * pc.x() / pc.z() + K.cx, v = K.fy * pc.y() / pc.z() + K.cy;
-	RgbdReprojectionCost exact({u, v}, pc.z(), 40.0, 1.0, K);
+	RgbdReprojectionCost exact({u, v}, pc.z(), 40.0, 1.0, 4.0, K);
 	double r0[3] = {1, 1, 1};
 	exact(qv, t, p, r0);
 	EXPECT_NEAR(std::abs(r0[0]) + std::abs(r0[1]) + std::abs(r0[2]), 0.0, 1e-9);
+	// A depth error alone moves only the third residual, to (bf / d - bf / z) / sigma_disparity,
+	// whatever the keypoint's pyramid level (invSigma) is.
+	for (const double invSigma : {1.0, 1.0 / std::pow(1.2, 5)})
+	{
+		const double d = pc.z() + 0.05;
+		RgbdReprojectionCost deep({u, v}, d, 40.0, invSigma, 4.0, K);
+		double r1[3];
+		deep(qv, t, p, r1);
+		EXPECT_NEAR(r1[0], 0.0, 1e-9);
+		EXPECT_NEAR(r1[1], 0.0, 1e-9);
+		EXPECT_NEAR(r1[2], (40.0 / d - 40.0 / pc.z()) * 4.0, 1e-9);
+	}
 	delete ad;
 	delete nd;
 }

@@ -222,10 +222,11 @@ BundleAdjustment::BundleAdjustment(
 			const double d = f.depth[kp];
 			const bool rgbd = d > 0 && d < o.maxDepthForRgbd;
 			ceres::CostFunction* cost = nullptr;
-			if (o.analyticJacobians) cost = new AnalyticBaCost(AnalyticReprojectionCost(uv, rgbd ? d : 0.0, o.bf, invSigma, K));
+			if (o.analyticJacobians)
+				cost = new AnalyticBaCost(AnalyticReprojectionCost(uv, rgbd ? d : 0.0, o.bf, invSigma, 1.0 / o.disparitySigma, K));
 			else if (rgbd)
 				cost = new ceres::AutoDiffCostFunction<RgbdReprojectionCost, 3, 4, 3, 3>(
-					new RgbdReprojectionCost(uv, d, o.bf, invSigma, K));
+					new RgbdReprojectionCost(uv, d, o.bf, invSigma, 1.0 / o.disparitySigma, K));
 			else
 				cost = new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3>(new MonoReprojectionCost(uv, invSigma, K));
 			auto& pq = m->poses[pi->second];

@@ -46,6 +46,7 @@ PoseOptimizerResult optimizePose(
 	const PinholeIntrinsics& K, const PoseOptimizerOptions& o)
 {
 	if (obs.empty()) throw std::invalid_argument("optimizePose: no observations");
+	if (!(o.disparitySigma > 0)) throw std::invalid_argument("optimizePose: disparitySigma must be > 0");
 	double q[4], t[3];
 	toCeres(T_world_cam, q, t);
 	const std::size_t n = obs.size();
@@ -62,7 +63,7 @@ PoseOptimizerResult optimizePose(
 		double e = du * du + dv * dv;
 		if (useDepth(ob))
 		{
-			const double dr = ((ob.uv.x() - o.bf / ob.depth) - ur) * ob.invSigma;
+			const double dr = (o.bf / ob.depth - (u - ur)) / o.disparitySigma;  // u - ur = bf / z
 			e += dr * dr;
 		}
 		return e;
@@ -94,7 +95,7 @@ PoseOptimizerResult optimizePose(
 				problem.AddResidualBlock(
 					new ceres::AutoDiffCostFunction<FixedPointCost<RgbdReprojectionCost>, 3, 4, 3>(
 						new FixedPointCost<RgbdReprojectionCost>(
-							RgbdReprojectionCost(ob.uv, ob.depth, o.bf, ob.invSigma, K), ob.p_world)),
+							RgbdReprojectionCost(ob.uv, ob.depth, o.bf, ob.invSigma, 1.0 / o.disparitySigma, K), ob.p_world)),
 					loss, q, t);
 			else
 				problem.AddResidualBlock(

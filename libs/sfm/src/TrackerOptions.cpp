@@ -37,6 +37,7 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	matcher.ratio = c.read_float(s, "match_ratio", matcher.ratio);
 	matcher.maxDepthError = c.read_float(s, "max_depth_error", matcher.maxDepthError);
 	pose.bf = c.read_double(s, "bf", pose.bf);
+	pose.disparitySigma = c.read_double(s, "disparity_sigma", pose.disparitySigma);
 	pose.rounds = c.read_int(s, "pose_rounds", pose.rounds);
 	pose.iterationsPerRound = c.read_int(s, "pose_iterations", pose.iterationsPerRound);
 	pnp.seed = static_cast<uint64_t>(c.read_uint64_t(s, "seed", pnp.seed));
@@ -47,6 +48,7 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	positive(s, "local_keyframes", localKeyFrames);
 	positive(s, "max_frames_between_keyframes", maxFramesBetweenKeyFrames);
 	positive(s, "bf", pose.bf);
+	positive(s, "disparity_sigma", pose.disparitySigma);
 	positive(s, "keyframe_ref_min_observations", keyFrameRefMinObservations);
 	positive(s, "pose_rounds", pose.rounds);
 	positive(s, "pose_iterations", pose.iterationsPerRound);
@@ -83,6 +85,7 @@ void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "match_ratio", matcher.ratio, 34, 40, "best/second-best");
 	c.write(s, "max_depth_error", matcher.maxDepthError, 34, 40, "|measured-predicted| depth / depth");
 	c.write(s, "bf", pose.bf, 34, 40, "virtual baseline x fx for depth residuals [px m]");
+	c.write(s, "disparity_sigma", pose.disparitySigma, 34, 40, "std-dev of the virtual disparity bf/depth [px]: sigma_z = this z^2/bf");
 	c.write(s, "pose_rounds", pose.rounds, 34, 40, "outlier rounds of pose refinement");
 	c.write(s, "pose_iterations", pose.iterationsPerRound, 34, 40, "iterations per round");
 	c.write(s, "seed", pnp.seed, 34, 40, "RANSAC seed");

@@ -27,6 +27,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	loop.loadFromConfigFile(c, "loop_closing");
 	// The depth residual model is shared by tracking and bundle adjustment.
 	mapping.ba.bf = tracker.pose.bf;
+	mapping.ba.disparitySigma = tracker.pose.disparitySigma;
 }
 
 void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const

@@ -45,6 +45,9 @@ struct BundleAdjusterOptions
 	double chi2Mono{5.991}, chi2Rgbd{7.815};
 	/** Virtual stereo baseline x fx for depth residuals (Default: 40) */
 	double bf{40.0};
+	/** Standard deviation of the virtual disparity bf / depth [px], level-independent
+	 * (Default: 0.25; see PoseOptimizerOptions::disparitySigma) */
+	double disparitySigma{0.25};
 	/** Depth residuals only for depths below this [m] (Default: 6) */
 	double maxDepthForRgbd{6.0};
 	/** Threads used by Ceres (Default: 1; results are then deterministic) */

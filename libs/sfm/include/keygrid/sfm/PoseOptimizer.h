@@ -28,6 +28,11 @@ struct PoseOptimizerOptions
 	double chi2Mono{5.991}, chi2Rgbd{7.815};
 	/** Virtual stereo baseline x fx [px m] (Default: 40, Kinect-like, as ORB-SLAM2's TUM configs) */
 	double bf{40.0};
+	/** Standard deviation of the virtual disparity bf / depth [px], the same at every pyramid
+	 * level; depth noise sigma_z = disparitySigma z^2 / bf (Default: 0.25; with bf = 40,
+	 * 6.25 mm z^2 [m]: about 4x the Kinect's sensor noise, for the depth read at corner
+	 * keypoints and the RGB/depth registration; see RgbdReprojectionCost.h) */
+	double disparitySigma{0.25};
 	/** Depth residuals only for depths below this [m] (Default: 6 m) */
 	double maxDepthForRgbd{6.0};
 };
