@@ -213,6 +213,23 @@ TEST(LocalBundleAdjuster, RemovesAGrossOutlierObservation)
 	EXPECT_LT((s.map.keyframe(2).T_world_cam - s.truePoses[2]).translation().norm(), 2e-3);
 }
 
+TEST(LocalBundleAdjuster, APointBehindTheCamerasIsDroppedInsteadOfStoppingTheSolve)
+{
+	// One landmark starts behind every camera: its residuals cannot be evaluated, which used
+	// to make Ceres abandon the whole adjustment (the poses stayed perturbed).
+	Scene s;
+	buildScene(s, 0.01, 0.02);
+	s.map.landmark(5).p_world = Eigen::Vector3d(0.1, 0.0, -2.0);
+	BundleAdjusterOptions o;
+	o.iterations = 30;
+	const auto rep = localBundleAdjustment(s.map, 3, K, o);
+	EXPECT_EQ(rep.observations, 316);
+	EXPECT_EQ(rep.outliersRemoved, 4);
+	EXPECT_FALSE(s.map.hasLandmark(5));
+	for (KeyFrameId k = 1; k < 4; k++)
+		EXPECT_LT((s.map.keyframe(k).T_world_cam - s.truePoses[k]).translation().norm(), 2e-4) << "kf " << k;
+}
+
 TEST(LocalBundleAdjuster, SolvedApartFromTheMapAndAppliedToWhatIsStillThere)
 {
 	// Threaded mode's sequence: build from the map, let tracking change the map (a landmark

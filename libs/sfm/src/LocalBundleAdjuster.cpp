@@ -24,6 +24,14 @@ class AnalyticBaCost final : public ceres::SizedCostFunction<3, 4, 3, 3>
 	AnalyticReprojectionCost m_cost;
 };
 
+/** The point in front of the camera (z > 1e-6 m, the projection's own validity bound). */
+bool inFrontOf(const double q_cam_world[4], const double t_cam_world[3], const double p_world[3])
+{
+	const Eigen::Map<const Eigen::Quaterniond> q(q_cam_world);
+	const Eigen::Map<const Eigen::Vector3d> t(t_cam_world), p(p_world);
+	return (q * p + t).z() > 1e-6;
+}
+
 /** Up to this many optimised keyframes the reduced camera system is solved densely. */
 constexpr std::size_t kAutoDenseMaxKeyFrames = 60;
 
@@ -136,6 +144,10 @@ struct BundleAdjustment::Problem
 	std::vector<LandmarkId> lms;  // in id order
 	std::vector<std::array<double, 3>> points;  // in the order of lms
 	std::vector<Obs> all;
+	/** Observations whose point starts behind (or at) its camera: left out of the problem
+	 * (one residual that cannot be evaluated at the start makes Ceres abandon the whole
+	 * solve) and removed as outliers by apply(). */
+	std::vector<std::pair<LandmarkId, KeyFrameId>> behind;
 	ceres::HuberLoss lossMono, lossRgbd;
 	std::shared_ptr<ceres::ParameterBlockOrdering> ordering = std::make_shared<ceres::ParameterBlockOrdering>();
 	ceres::Problem problem;
@@ -230,6 +242,12 @@ BundleAdjustment::BundleAdjustment(
 			else
 				cost = new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3>(new MonoReprojectionCost(uv, invSigma, K));
 			auto& pq = m->poses[pi->second];
+			if (!inFrontOf(pq.data(), pq.data() + 4, point))
+			{
+				delete cost;
+				m->behind.emplace_back(lm, kf);
+				continue;
+			}
 			const auto block = problem.AddResidualBlock(
 				cost, rgbd ? &m->lossRgbd : &m->lossMono, pq.data(), pq.data() + 4, point);
 			if (all.empty() || all.back().lm != lm) m->ordering->AddElementToGroup(point, 0);
@@ -293,6 +311,12 @@ BundleAdjusterReport BundleAdjustment::apply(SparseMap& map)
 			map.landmark(m->lms[i]).p_world = Eigen::Vector3d(p[0], p[1], p[2]);
 		}
 	const auto& o = m->opts;
+	for (const auto& [lm, kf] : m->behind)
+		if (map.hasLandmark(lm) && map.landmark(lm).observations.count(kf))
+		{
+			map.eraseObservation(lm, kf);
+			rep.outliersRemoved++;
+		}
 	for (const auto& ob : m->all)
 	{
 		double cost = 0;
