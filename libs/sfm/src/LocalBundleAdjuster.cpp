@@ -24,14 +24,6 @@ class AnalyticBaCost final : public ceres::SizedCostFunction<3, 4, 3, 3>
 	AnalyticReprojectionCost m_cost;
 };
 
-/** The point in front of the camera (z > 1e-6 m, the projection's own validity bound). */
-bool inFrontOf(const double q_cam_world[4], const double t_cam_world[3], const double p_world[3])
-{
-	const Eigen::Map<const Eigen::Quaterniond> q(q_cam_world);
-	const Eigen::Map<const Eigen::Vector3d> t(t_cam_world), p(p_world);
-	return (q * p + t).z() > 1e-6;
-}
-
 /** Up to this many optimised keyframes the reduced camera system is solved densely. */
 constexpr std::size_t kAutoDenseMaxKeyFrames = 60;
 
@@ -228,6 +220,13 @@ BundleAdjustment::BundleAdjustment(
 		{
 			const auto pi = m->poseIndex.find(kf);
 			if (pi == m->poseIndex.end()) continue;
+			auto& pq = m->poses[pi->second];
+			double u, v, ur;
+			if (!projectRgbd(pq.data(), pq.data() + 4, static_cast<const double*>(point), K, 0.0, u, v, ur))
+			{
+				m->behind.emplace_back(lm, kf);
+				continue;
+			}
 			const auto& f = map.keyframe(kf).features;
 			const Eigen::Vector2d uv(f.undistorted[kp].x, f.undistorted[kp].y);
 			const double invSigma = 1.0 / f.levelScale[f.keypoints[kp].octave];
@@ -241,13 +240,6 @@ BundleAdjustment::BundleAdjustment(
 					new RgbdReprojectionCost(uv, d, o.bf, invSigma, 1.0 / o.disparitySigma, K));
 			else
 				cost = new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3>(new MonoReprojectionCost(uv, invSigma, K));
-			auto& pq = m->poses[pi->second];
-			if (!inFrontOf(pq.data(), pq.data() + 4, point))
-			{
-				delete cost;
-				m->behind.emplace_back(lm, kf);
-				continue;
-			}
 			const auto block = problem.AddResidualBlock(
 				cost, rgbd ? &m->lossRgbd : &m->lossMono, pq.data(), pq.data() + 4, point);
 			if (all.empty() || all.back().lm != lm) m->ordering->AddElementToGroup(point, 0);
