@@ -87,6 +87,22 @@ TEST(PoseOptimizer, RejectsOutliersUnderNoise)
 	EXPECT_LT((T - s.T_world_cam).translation().norm(), 2e-3);
 }
 
+TEST(PoseOptimizer, APointBehindTheCameraIsAnOutlierInsteadOfStoppingTheSolve)
+{
+	auto s = makeScene(200, 0.0, 0, 3);
+	// A wrong association with a point 1 m behind the camera (e.g. a stale landmark).
+	double wx, wy, wz;
+	s.T_world_cam.composePoint(0.1, 0.1, -1.0, wx, wy, wz);
+	s.obs[0].p_world = {wx, wy, wz};
+	PoseOptimizerOptions o;
+	o.rounds = 1;  // a single round: nothing to recover in if the first solve stops
+	CPose3D T = s.T_world_cam + CPose3D(0.05, -0.04, 0.03, 0.04, 0.03, -0.05);
+	const auto r = optimizePose(T, s.obs, K, o);
+	EXPECT_FALSE(r.inlier[0]);
+	EXPECT_EQ(r.inliers, 199);
+	EXPECT_NEAR(poseError(T, s.T_world_cam), 0.0, 1e-6);
+}
+
 TEST(PnpSolver, RecoversKnownPoseDespiteOutliers)
 {
 	const auto s = makeScene(150, 0.3, 40, 3);

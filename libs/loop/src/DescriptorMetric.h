@@ -6,6 +6,7 @@
  * Both give "distance" values whose ordering is what k-means and the tree descent need;
  * k-means++ seeding uses distance^2 for Hamming and the squared L2 itself for floats.
  */
+#include <keygrid/core/Hamming.h>
 #include <opencv2/core.hpp>
 
 #include <cstdint>
@@ -26,9 +27,9 @@ struct BinaryMetric
 			std::uint64_t x, y;
 			std::memcpy(&x, a + i, 8);
 			std::memcpy(&y, b + i, 8);
-			d += __builtin_popcountll(x ^ y);
+			d += core::popcount64(x ^ y);
 		}
-		for (; i < cols; ++i) d += __builtin_popcount(static_cast<unsigned>(a[i] ^ b[i]));
+		for (; i < cols; ++i) d += core::popcount64(static_cast<std::uint64_t>(a[i] ^ b[i]));
 		return d;
 	}
 	/** Weight of k-means++ seeding: D(x)^2. */

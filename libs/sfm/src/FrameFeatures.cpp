@@ -1,3 +1,4 @@
+#include <keygrid/core/Hamming.h>
 #include <keygrid/sfm/FrameFeatures.h>
 
 #include <algorithm>
@@ -48,9 +49,7 @@ float descriptorDistance(const cv::Mat& a, const cv::Mat& b)
 	{
 		const auto* pa = a.ptr<uint64_t>();
 		const auto* pb = b.ptr<uint64_t>();
-		int d = 0;
-		for (int i = 0; i < a.cols / 8; i++) d += __builtin_popcountll(pa[i] ^ pb[i]);
-		return static_cast<float>(d);
+		return static_cast<float>(core::hammingDistance(pa, pb, a.cols / 8));
 	}
 	return static_cast<float>(cv::norm(a, b, cv::NORM_L2));
 }

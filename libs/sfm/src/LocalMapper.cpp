@@ -4,6 +4,7 @@
 #include <keygrid/sfm/Triangulation.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <set>
 
@@ -47,30 +48,47 @@ LocalMapper::LocalMapper(SparseMap& map, const LocalMapperOptions& opts, const M
 LocalMappingReport LocalMapper::process(KeyFrameId kf, const PinholeIntrinsics& K, std::unique_lock<std::mutex>* mapLock)
 {
 	LocalMappingReport rep;
+	auto t = std::chrono::steady_clock::now();
+	auto lap = [&](const char* stage) {
+		const auto now = std::chrono::steady_clock::now();
+		rep.stageSeconds.emplace_back(stage, std::chrono::duration<double>(now - t).count());
+		t = now;
+	};
 	// Landmarks created by this keyframe join the probation list.
 	for (LandmarkId l : m_map.keyframe(kf).landmarks)
 		if (l != kNoLandmark && m_map.hasLandmark(l) && m_map.landmark(l).firstKeyFrame == kf) m_recent.push_back(l);
 	rep.culledLandmarks = cullRecentLandmarks(kf);
+	lap("cull");
 	if (m_map.numKeyFrames() > 1)
 	{
 		rep.triangulated = triangulateNew(kf, K);
+		lap("triangulate");
 		fuse(kf, K, rep);
 		m_map.updateCovisibility(kf);
-		if (m_opts.localBundleAdjustment && !mapLock) rep.ba = localBundleAdjustment(m_map, kf, K, m_opts.ba);
+		lap("fuse");
+		if (m_opts.localBundleAdjustment && !mapLock)
+		{
+			rep.ba = localBundleAdjustment(m_map, kf, K, m_opts.ba);
+			lap("ba");
+		}
 		else if (m_opts.localBundleAdjustment)
 		{
 			auto ba = BundleAdjustment::around(m_map, kf, K, m_opts.ba);
 			const auto corrections = m_map.corrections();
+			lap("ba_build");
 			mapLock->unlock();
 			ba.solve();
 			mapLock->lock();
+			lap("ba_solve");
 			// Only the mapper erases keyframes, so kf is still there; a loop correction that
 			// happened during the solve would be undone by writing back the old-frame result.
 			if (m_map.corrections() == corrections) rep.ba = ba.apply(m_map);
 			else
 				rep.baDiscarded = true;
+			lap("ba_apply");
 		}
 		rep.culledKeyFrames = cullKeyFrames(kf);
+		lap("cull_keyframes");
 	}
 	return rep;
 }

@@ -1,3 +1,4 @@
+#include <keygrid/core/Hamming.h>
 #include <keygrid/sfm/Matcher.h>
 #include <opencv2/features2d.hpp>
 
@@ -46,9 +47,14 @@ int searchByProjection(
 	const MatcherOptions& o, std::vector<LandmarkId>& matches)
 {
 	const float maxDist = o.maxDistance(f.isBinary());
+	// ORB rows compared in place (no cv::Mat header per pair); other descriptors by descriptorDistance.
+	const bool rawRows = f.isBinary() && f.descriptors.cols % 8 == 0 && f.descriptors.isContinuous();
+	const int words = f.descriptors.cols / 8;
 	int added = 0;
 	for (const auto& c : cands)
 	{
+		const bool raw = rawRows && c.descriptor->isContinuous() && c.descriptor->type() == CV_8U &&
+			c.descriptor->cols == f.descriptors.cols;
 		const float r = radius * static_cast<float>(f.levelScale.empty() ? 1.0 : f.levelScale[c.predictedLevel]);
 		const auto idx = f.featuresInArea(c.u, c.v, r, std::max(0, c.predictedLevel - 1), c.predictedLevel + 1);
 		float best = 1e30f, second = 1e30f;
@@ -58,7 +64,9 @@ int searchByProjection(
 			if (matches[i] != kNoLandmark) continue;
 			const float d = f.depth[i];
 			if (d > 0 && std::abs(d - c.depth) > o.maxDepthError * c.depth) continue;
-			const float dist = descriptorDistance(*c.descriptor, f.descriptors.row(i));
+			const float dist = raw ? static_cast<float>(core::hammingDistance(
+										 c.descriptor->ptr<std::uint64_t>(), f.descriptors.ptr<std::uint64_t>(i), words))
+								   : descriptorDistance(*c.descriptor, f.descriptors.row(i));
 			if (dist < best)
 			{
 				second = best;
@@ -119,9 +127,7 @@ std::vector<std::pair<int, int>> matchSubsetBruteForce(
 		if (!raw) return descriptorDistance(da.row(ra), db.row(rb));
 		const auto* pa = da.ptr<std::uint64_t>(ra);
 		const auto* pb = db.ptr<std::uint64_t>(rb);
-		int d = 0;
-		for (int w = 0; w < words; w++) d += __builtin_popcountll(pa[w] ^ pb[w]);
-		return static_cast<float>(d);
+		return static_cast<float>(core::hammingDistance(pa, pb, words));
 	};
 	for (int i : ia)
 	{

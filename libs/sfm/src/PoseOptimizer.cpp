@@ -8,6 +8,26 @@
 
 namespace keygrid::sfm
 {
+namespace
+{
+/** Pose-only form of AnalyticReprojectionCost (hand-written Jacobians, see
+ * RgbdReprojectionCost.h): the point is a constant. Parameters q_cam_world (x,y,z,w) and
+ * t_cam_world; 3 residuals, the third one 0 without depth. */
+class AnalyticPoseCost final : public ceres::SizedCostFunction<3, 4, 3>
+{
+   public:
+	AnalyticPoseCost(const AnalyticReprojectionCost& c, const Eigen::Vector3d& p_world) : m_cost(c), m_p(p_world) {}
+	bool Evaluate(double const* const* x, double* r, double** J) const override
+	{
+		return m_cost.evaluate(x[0], x[1], m_p.data(), r, J ? J[0] : nullptr, J ? J[1] : nullptr, nullptr);
+	}
+
+   private:
+	AnalyticReprojectionCost m_cost;
+	Eigen::Vector3d m_p;
+};
+}  // namespace
+
 void toCeres(const mrpt::poses::CPose3D& T_world_cam, double q[4], double t[3])
 {
 	const auto T_cam_world = -T_world_cam;
@@ -69,6 +89,10 @@ PoseOptimizerResult optimizePose(
 		return e;
 	};
 
+	// A point behind the camera at the initial pose would make Ceres stop at its first
+	// evaluation: such observations start as outliers (they may come back after a round).
+	for (std::size_t i = 0; i < n; i++) res.inlier[i] = chi2(obs[i]) < 1e30;
+
 	ceres::Solver::Options so;
 	so.linear_solver_type = ceres::DENSE_QR;
 	so.max_num_iterations = o.iterationsPerRound;
@@ -76,10 +100,13 @@ PoseOptimizerResult optimizePose(
 	so.logging_type = ceres::SILENT;
 	so.minimizer_progress_to_stdout = false;
 
+	// One Huber loss per observation kind, shared by all residual blocks of a round.
+	ceres::HuberLoss huberRgbd(std::sqrt(o.chi2Rgbd)), huberMono(std::sqrt(o.chi2Mono));
 	for (int round = 0; round < o.rounds; round++)
 	{
 		ceres::Problem::Options po;
 		po.manifold_ownership = ceres::TAKE_OWNERSHIP;
+		po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
 		ceres::Problem problem(po);
 		problem.AddParameterBlock(q, 4, new ceres::EigenQuaternionManifold());
 		problem.AddParameterBlock(t, 3);
@@ -90,18 +117,9 @@ PoseOptimizerResult optimizePose(
 			const auto& ob = obs[i];
 			// Huber only in the first rounds: later rounds see inliers only (as ORB-SLAM2).
 			ceres::LossFunction* loss = nullptr;
-			if (round < o.rounds - 1) loss = new ceres::HuberLoss(std::sqrt(useDepth(ob) ? o.chi2Rgbd : o.chi2Mono));
-			if (useDepth(ob))
-				problem.AddResidualBlock(
-					new ceres::AutoDiffCostFunction<FixedPointCost<RgbdReprojectionCost>, 3, 4, 3>(
-						new FixedPointCost<RgbdReprojectionCost>(
-							RgbdReprojectionCost(ob.uv, ob.depth, o.bf, ob.invSigma, 1.0 / o.disparitySigma, K), ob.p_world)),
-					loss, q, t);
-			else
-				problem.AddResidualBlock(
-					new ceres::AutoDiffCostFunction<FixedPointCost<MonoReprojectionCost>, 2, 4, 3>(
-						new FixedPointCost<MonoReprojectionCost>(MonoReprojectionCost(ob.uv, ob.invSigma, K), ob.p_world)),
-					loss, q, t);
+			if (round < o.rounds - 1) loss = useDepth(ob) ? &huberRgbd : &huberMono;
+			const AnalyticReprojectionCost cost(ob.uv, useDepth(ob) ? ob.depth : 0.0, o.bf, ob.invSigma, 1.0 / o.disparitySigma, K);
+			problem.AddResidualBlock(new AnalyticPoseCost(cost, ob.p_world), loss, q, t);
 			++used;
 		}
 		if (used < 3) break;

@@ -4,6 +4,7 @@
 #include <ctime>
 #include <numeric>
 #include <set>
+#include <unordered_set>
 
 namespace keygrid::sfm
 {
@@ -196,8 +197,10 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 
 std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool forLocalMap)
 {
-	std::set<LandmarkId> already(cur.matches.begin(), cur.matches.end());
-	std::set<LandmarkId> seen;
+	// Hash sets: this runs twice per frame over every landmark of the local keyframes.
+	const std::unordered_set<LandmarkId> already(cur.matches.begin(), cur.matches.end());
+	std::unordered_set<LandmarkId> seen;
+	seen.reserve(4096);
 	std::vector<ProjectedLandmark> inView;
 	const auto T_cam_world = -cur.T_world_cam;
 	const Eigen::Vector3d center = translationOf(cur.T_world_cam);
@@ -207,9 +210,10 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool
 		for (LandmarkId id : m_map.keyframe(kfId).landmarks)
 		{
 			if (id == kNoLandmark || already.count(id) || !seen.insert(id).second) continue;
-			if (!m_map.hasLandmark(id)) continue;
+			const Landmark* lm = m_map.findLandmark(id);
+			if (!lm) continue;
 			ProjectedLandmark p;
-			if (projectLandmark(m_map.landmark(id), T_cam_world, center, m_K, cur.features, m_opts.matcher, p)) inView.push_back(p);
+			if (projectLandmark(*lm, T_cam_world, center, m_K, cur.features, m_opts.matcher, p)) inView.push_back(p);
 		}
 	}
 	// HOC selection (everything passes without HOC), timed as one pass.
@@ -236,10 +240,11 @@ int Tracker::refinePose(Current& cur)
 	std::vector<int> kpOf;
 	for (std::size_t i = 0; i < cur.matches.size(); i++)
 	{
-		if (cur.matches[i] == kNoLandmark || !m_map.hasLandmark(cur.matches[i])) continue;
+		const Landmark* lm = cur.matches[i] == kNoLandmark ? nullptr : m_map.findLandmark(cur.matches[i]);
+		if (!lm) continue;
 		const auto& f = cur.features;
 		PoseObservation o;
-		o.p_world = m_map.landmark(cur.matches[i]).p_world;
+		o.p_world = lm->p_world;
 		o.uv = {f.undistorted[i].x, f.undistorted[i].y};
 		o.depth = f.depth[i];
 		o.invSigma = 1.0 / f.levelScale[f.keypoints[i].octave];
@@ -364,7 +369,7 @@ int Tracker::trackLocalMap(Current& cur, float radius)
 {
 	// Landmarks matched before this stage were in view too.
 	for (LandmarkId l : cur.matches)
-		if (l != kNoLandmark && m_map.hasLandmark(l)) m_map.landmark(l).visibleCount++;
+		if (Landmark* lm = l == kNoLandmark ? nullptr : m_map.findLandmark(l)) lm->visibleCount++;
 	cur.matchedBeforeLocalMap = cur.matches;
 	cur.hocExcluded.clear();
 	auto cands = projectLocalLandmarks(cur, true);
@@ -373,7 +378,7 @@ int Tracker::trackLocalMap(Current& cur, float radius)
 	if (m_hoc) cur.hocVisible = cands;
 	const int inl = refinePose(cur);
 	for (LandmarkId l : cur.matches)
-		if (l != kNoLandmark && m_map.hasLandmark(l)) m_map.landmark(l).foundCount++;
+		if (Landmark* lm = l == kNoLandmark ? nullptr : m_map.findLandmark(l)) lm->foundCount++;
 	return inl;
 }
 

@@ -11,6 +11,8 @@
 #include <deque>
 #include <mutex>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace mrpt::config
 {
@@ -52,6 +54,9 @@ struct LocalMappingReport
 	/** Threaded mode: the bundle adjustment was solved, but a loop closure corrected the map
 	 * meanwhile, so its result was dropped. */
 	bool baDiscarded{false};
+	/** Wall time of each step, in order: "cull", "triangulate", "fuse", "ba_build", "ba_solve",
+	 * "ba_apply", "cull_keyframes" (sequential mode builds, solves and applies as "ba"). */
+	std::vector<std::pair<std::string, double>> stageSeconds;
 };
 
 class LocalMapper

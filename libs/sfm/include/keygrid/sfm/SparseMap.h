@@ -97,6 +97,12 @@ class SparseMap
 	KeyFrame& keyframe(KeyFrameId id) { return m_keyframes.at(id); }
 	const KeyFrame& keyframe(KeyFrameId id) const { return m_keyframes.at(id); }
 	Landmark& landmark(LandmarkId id) { return m_landmarks.at(id); }
+	/** The landmark, or nullptr when it does not exist (one lookup instead of has + get). */
+	Landmark* findLandmark(LandmarkId id)
+	{
+		const auto it = m_landmarks.find(id);
+		return it == m_landmarks.end() ? nullptr : &it->second;
+	}
 	const Landmark& landmark(LandmarkId id) const { return m_landmarks.at(id); }
 	const std::map<KeyFrameId, KeyFrame>& keyframes() const { return m_keyframes; }
 	const std::map<LandmarkId, Landmark>& landmarks() const { return m_landmarks; }
