@@ -42,7 +42,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "");
 	maps.saveToConfigFile(c, "maps");
 	loop.saveToConfigFile(c, "loop_closing");
-	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame against the final map");
+	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame that is not a keyframe against the final map");
 }
 
 void SlamConfig::checkKnownKeys(const mrpt::config::CConfigFileBase& c)

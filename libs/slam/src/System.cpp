@@ -103,6 +103,7 @@ void System::mapKeyFrame(const KeyFrameJob& job, std::unique_lock<std::mutex>* m
 	const auto t0 = std::chrono::steady_clock::now();
 	const auto rep = m_mapper.process(job.keyframe, job.K, mapLock);
 	m_timings.add("local_mapping", secondsSince(t0));
+	for (const auto& [stage, sec] : rep.stageSeconds) m_timings.add("local_mapping:" + stage, sec);
 	std::lock_guard<std::mutex> lk(m_statsMutex);
 	m_stats.keyframesCreated++;
 	m_stats.keyframesCulled += rep.culledKeyFrames;
@@ -262,6 +263,9 @@ void System::finish()
 	{
 		const auto& f = m_frames[i];
 		if (!f.tracked) continue;
+		// A keyframe keeps its pose from the (global) bundle adjustment: that joint estimate
+		// beats a pose-only one against points it helped place (measured in doc/evaluation.md).
+		if (f.newKeyFrame && m_map.hasKeyFrame(f.keyframe)) continue;
 		std::vector<sfm::PoseObservation> obs;
 		for (std::size_t k = 0; k < f.observations.size(); k++)
 		{
