@@ -18,6 +18,12 @@ Definitions (doc/loop-closure.md):
 * Revisit event: a maximal run of consecutive frames with a GT revisit.
 * A detected loop (query frame, frame of its loop keyframe) is a true positive when their GT
   poses are within 1 m and 45 deg, else a false positive.
+* Independently of TP/false, a detection's constraint is **correct** when the relative pose
+  that geometric verification measured agrees with ground truth: camera distance within
+  CONSTRAINT_DIST_M and relative rotation angle within CONSTRAINT_ANGLE_DEG
+  (report.json `measured_distance_m`, `measured_angle_deg`). A wrong constraint is what corrupts
+  a pose graph; a correct one between cameras farther apart than TP_DIST_M (two views of the
+  same wall from 2.5 m apart) is a false positive of place recognition but not a false loop.
 * Precision = TP / detections; recall = events with a TP detection inside [start - 1 s, end + 1 s]
   / events ("strict": inside [start, end + 1 s]; a TP detection can precede the event because the
   TP radius, 1 m, is larger than the revisit radius, 0.5 m).
@@ -38,11 +44,14 @@ REVISIT_MIN_PATH_M = 2.0
 TP_DIST_M = 1.0
 TP_ANGLE_DEG = 45.0
 EVENT_GRACE_S = 1.0
+CONSTRAINT_DIST_M = 0.10
+CONSTRAINT_ANGLE_DEG = 5.0
 ASSOC_MAX_DT_S = 0.02
 
 
-def read_tum(path):
-	"""TUM trajectory -> (timestamps [N], centres [N, 3], optical axes [N, 3])."""
+def read_tum(path, with_quaternions=False):
+	"""TUM trajectory -> (timestamps [N], centres [N, 3], optical axes [N, 3]) and, when asked,
+	the unit quaternions [N, 4] (x, y, z, w)."""
 	rows = []
 	with open(path) as f:
 		for line in f:
@@ -57,7 +66,14 @@ def read_tum(path):
 	x, y, z, w = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
 	# Third column of the rotation matrix: the camera's optical (z) axis in the world.
 	axis = np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)], axis=1)
+	if with_quaternions:
+		return t, p, axis, q
 	return t, p, axis
+
+
+def rotation_angle_deg(qa, qb):
+	"""Angle of the relative rotation between two unit quaternions."""
+	return float(np.degrees(2 * np.arccos(min(1.0, abs(float(np.dot(qa, qb)))))))
 
 
 def read_frames(run):
@@ -132,13 +148,14 @@ def score(args):
 		rep = json.load(f)
 	ft, kf_at = read_frames(args.run)
 	kf_frame = {int(k): i for i, k in enumerate(kf_at) if k >= 0}
-	gt_t, gt_c, gt_ax = read_tum(args.gt)
+	gt_t, gt_c, gt_ax, gt_q = read_tum(args.gt, with_quaternions=True)
 	gi = associate(ft, gt_t)
 	valid = gi >= 0
 	# GT per frame (frames without GT get NaN and never count).
 	c = np.full((len(ft), 3), np.nan)
 	ax = np.full((len(ft), 3), np.nan)
-	c[valid], ax[valid] = gt_c[gi[valid]], gt_ax[gi[valid]]
+	qs = np.full((len(ft), 4), np.nan)
+	c[valid], ax[valid], qs[valid] = gt_c[gi[valid]], gt_ax[gi[valid]], gt_q[gi[valid]]
 	vidx = np.nonzero(valid)[0]
 	has_v, best_v = revisits(ft[vidx], c[vidx], ax[vidx])
 	has = np.zeros(len(ft), dtype=bool)
@@ -166,6 +183,12 @@ def score(args):
 			d['gt_dist_m'] = float(np.linalg.norm(c[q] - c[lf]))
 			d['gt_angle_deg'] = float(angle_deg(ax[q], ax[lf]))
 			d['tp'] = bool(d['gt_dist_m'] <= TP_DIST_M and d['gt_angle_deg'] <= TP_ANGLE_DEG)
+			if 'measured_distance_m' in ev and 'measured_angle_deg' in ev:
+				d['gt_rotation_deg'] = rotation_angle_deg(qs[q], qs[lf])
+				d['measured_distance_m'] = float(ev['measured_distance_m'])
+				d['measured_angle_deg'] = float(ev['measured_angle_deg'])
+				d['constraint_ok'] = bool(abs(d['measured_distance_m'] - d['gt_dist_m']) <= CONSTRAINT_DIST_M and
+										  abs(d['measured_angle_deg'] - d['gt_rotation_deg']) <= CONSTRAINT_ANGLE_DEG)
 		dets.append(d)
 
 	ev_out = []
@@ -179,6 +202,7 @@ def score(args):
 		ev_out.append(e)
 	tp = sum(1 for d in dets if d['tp'])
 	fp = sum(1 for d in dets if d['tp'] is False)
+	wrong = sum(1 for d in dets if d.get('constraint_ok') is False)
 	res = {
 		'name': args.name or os.path.basename(os.path.normpath(args.run)),
 		'mode': args.mode,
@@ -186,7 +210,7 @@ def score(args):
 		'frames_with_gt': int(valid.sum()),
 		'keyframes_created': int(rep.get('keyframes_created', -1)),
 		'keyframes': int(rep.get('keyframes', -1)),
-		'detections': len(dets), 'tp': tp, 'fp': fp,
+		'detections': len(dets), 'tp': tp, 'fp': fp, 'wrong_constraints': wrong,
 		'precision': (tp / len(dets)) if dets else None,
 		'events': len(ev_out), 'events_detected': sum(1 for e in ev_out if e['detected']),
 		'recall': (sum(1 for e in ev_out if e['detected']) / len(ev_out)) if ev_out else None,
@@ -208,10 +232,13 @@ def score(args):
 			('detected at frame %d' % e['first_detection'] + ('' if e.get('detected_strict', True) else ' (before the event)'))
 			if e['detected'] else 'MISSED'))
 	for d in dets:
-		print('  loop frame %d (kf %d) -> kf %d (frame %d): %s%s' % (
+		print('  loop frame %d (kf %d) -> kf %d (frame %d): %s%s%s' % (
 			d['frame'], d['keyframe'], d['loop_keyframe'], d['loop_frame'],
 			{True: 'TP', False: 'FALSE', None: 'unscored'}[d['tp']],
-			' (GT %.2f m, %.1f deg)' % (d['gt_dist_m'], d['gt_angle_deg']) if 'gt_dist_m' in d else ''))
+			' (GT %.2f m, %.1f deg)' % (d['gt_dist_m'], d['gt_angle_deg']) if 'gt_dist_m' in d else '',
+			'; constraint %s: measured %.2f m / %.1f deg, GT %.2f m / %.1f deg' % (
+				'correct' if d['constraint_ok'] else 'WRONG', d['measured_distance_m'], d['measured_angle_deg'],
+				d['gt_dist_m'], d['gt_rotation_deg']) if 'constraint_ok' in d else ''))
 	for w in warnings:
 		print('  warning: ' + w)
 
@@ -221,8 +248,8 @@ def fmt(v, f='%.3f'):
 
 
 def summary_line(r):
-	return '%s [%s]: %d detections, %d TP, %d false, precision %s, recall %d/%d, ATE %s m' % (
-		r['name'], r['mode'], r['detections'], r['tp'], r['fp'], fmt(r['precision'], '%.2f'),
+	return '%s [%s]: %d detections, %d TP, %d false, %d wrong constraints, precision %s, recall %d/%d, ATE %s m' % (
+		r['name'], r['mode'], r['detections'], r['tp'], r['fp'], r.get('wrong_constraints', 0), fmt(r['precision'], '%.2f'),
 		r['events_detected'], r['events'], fmt(r['ate_rmse_m']))
 
 
@@ -244,8 +271,8 @@ def table(args):
 	matrix(rs)
 	# Totals per vocabulary choice.
 	print()
-	print('| vocabulary | sequences | detections | TP | false | precision | recall (events) | strict recall |')
-	print('|---|---|---|---|---|---|---|---|')
+	print('| vocabulary | sequences | detections | TP | false | wrong constraints | precision | recall (events) | strict recall |')
+	print('|---|---|---|---|---|---|---|---|---|')
 	modes = []
 	for r in rs:
 		if r['mode'] not in modes:
@@ -258,7 +285,8 @@ def table(args):
 		ev = sum(r['events'] for r in sel)
 		evd = sum(r['events_detected'] for r in sel)
 		evs = sum(r.get('events_detected_strict', r['events_detected']) for r in sel)
-		print('| %s | %d | %d | %d | %d | %s | %d/%d | %d/%d |' % (m, len(sel), det, tp, fp, fmt(tp / det if det else None, '%.2f'), evd, ev, evs, ev))
+		wrong = sum(r.get('wrong_constraints', 0) for r in sel)
+		print('| %s | %d | %d | %d | %d | %d | %s | %d/%d | %d/%d |' % (m, len(sel), det, tp, fp, wrong, fmt(tp / det if det else None, '%.2f'), evd, ev, evs, ev))
 
 
 def matrix(rs):
