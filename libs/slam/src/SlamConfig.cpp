@@ -12,8 +12,11 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 {
 	mode = c.read_string("slam", "mode", mode);
 	camera = c.read_string("slam", "camera", camera);
+	mappingLag = c.read_int("slam", "mapping_lag", mappingLag);
 	if (mode != "sequential" && mode != "threaded")
 		throw std::invalid_argument("[slam] mode = '" + mode + "' (expected sequential or threaded)");
+	if (mappingLag < 0 || mappingLag > 5)
+		throw std::invalid_argument("[slam] mapping_lag = " + std::to_string(mappingLag) + " (expected 0..5)");
 	features.loadFromConfigFile(c, "features");
 	tracker.loadFromConfigFile(c, "tracker");
 	tracker.hoc.loadFromConfigFile(c, "hoc");
@@ -34,6 +37,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 {
 	c.write("slam", "mode", mode, 30, 40, "sequential | threaded");
 	c.write("slam", "camera", camera.empty() ? std::string("auto") : camera, 30, 40, "preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
+	c.write("slam", "mapping_lag", mappingLag, 30, 40, "threaded: keyframes local mapping may lag behind tracking (0: none)");
 	features.saveToConfigFile(c, "features");
 	tracker.saveToConfigFile(c, "tracker");
 	tracker.hoc.saveToConfigFile(c, "hoc");

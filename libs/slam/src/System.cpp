@@ -94,7 +94,12 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	}
 	const bool queueKeyFrame = tf.newKeyFrame && m_mappingQueue;
 	m_frames.push_back(std::move(tf));
-	if (queueKeyFrame && !m_mappingQueue->push(job)) throwIfBackgroundFailed();
+	if (queueKeyFrame)
+	{
+		if (!m_mappingQueue->push(job)) throwIfBackgroundFailed();
+		m_jobsQueued++;
+		waitForMapping();
+	}
 	return m_frames.back();
 }
 
@@ -150,17 +155,43 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 	m_loops.push_back(std::move(*ev));
 }
 
+void System::waitForMapping()
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	std::unique_lock<std::mutex> lk(m_statsMutex);
+	const auto lag = static_cast<std::size_t>(m_cfg.mappingLag);
+	m_jobMapped.wait(lk, [&] { return m_jobsMapped + lag >= m_jobsQueued || !m_backgroundError.empty(); });
+	lk.unlock();
+	m_timings.add("mapping_wait", secondsSince(t0));
+	throwIfBackgroundFailed();
+}
+
 void System::mappingThread()
 {
+	// Counts a job as mapped however its processing ends, so that tracking never waits forever.
+	const auto jobDone = [this]
+	{
+		{
+			std::lock_guard<std::mutex> lk(m_statsMutex);
+			m_jobsMapped++;
+		}
+		m_jobMapped.notify_all();
+	};
 	try
 	{
 		while (auto job = m_mappingQueue->pop())
 		{
 			std::unique_lock<std::mutex> lock(m_map.mutex());
 			// A keyframe still queued may have been culled as redundant meanwhile.
-			if (!m_map.hasKeyFrame(job->keyframe)) continue;
+			if (!m_map.hasKeyFrame(job->keyframe))
+			{
+				lock.unlock();
+				jobDone();
+				continue;
+			}
 			mapKeyFrame(*job, &lock);
 			lock.unlock();
+			jobDone();
 			if (!m_loopQueue->push(*job)) break;
 		}
 	}
@@ -193,6 +224,7 @@ void System::setBackgroundError(const std::string& what)
 		std::lock_guard<std::mutex> lk(m_statsMutex);
 		if (m_backgroundError.empty()) m_backgroundError = what;
 	}
+	m_jobMapped.notify_all();  // tracking may be waiting for local mapping
 	// Nothing more is accepted: tracking's next push fails and reports the error.
 	m_mappingQueue->close();
 	m_loopQueue->close();

@@ -35,6 +35,13 @@ struct SlamConfig
 	/** Camera for TUM folders: preset name or INI path; "auto" (or empty) = camera.ini in the
 	 * folder, else guessed from the folder name (Default: auto) */
 	std::string camera{"auto"};
+	/** Threaded mode: how many keyframes local mapping may still be working on while tracking
+	 * goes on. 0: tracking waits until each new keyframe is mapped (triangulated, fused,
+	 * bundle-adjusted) before the next frame, so it sees the map sequential mode sees;
+	 * decoding, extraction and loop closing still run alongside. Larger values let tracking
+	 * run ahead of a lagging map (measured less accurate, doc/frontend.md "Modes"); at most 5
+	 * (the queue holds 4 waiting keyframes). (Default: 0) */
+	int mappingLag{0};
 	sfm::FeatureOptions features;
 	sfm::TrackerOptions tracker;
 	sfm::LocalMapperOptions mapping;

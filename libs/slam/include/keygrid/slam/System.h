@@ -23,6 +23,7 @@
 
 #include <keygrid/core/BoundedQueue.h>
 
+#include <condition_variable>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -110,6 +111,9 @@ class System
 	 * tracker's last frame, which created the keyframe. */
 	void insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
 	void mappingThread();
+	/** Threaded mode, tracking thread: blocks until local mapping is at most [slam]
+	 * mapping_lag keyframes behind (throws if a background thread failed). */
+	void waitForMapping();
 	void loopClosingThread();
 	void setBackgroundError(const std::string& what);
 	void throwIfBackgroundFailed() const;
@@ -137,6 +141,10 @@ class System
 	StageTimings m_timings;
 	std::string m_backgroundError;
 	// Threaded mode.
+	/** Keyframes handed to local mapping (tracking thread) and done by it (m_statsMutex);
+	 * [slam] mapping_lag bounds the difference. */
+	std::size_t m_jobsQueued{0}, m_jobsMapped{0};
+	std::condition_variable m_jobMapped;
 	std::unique_ptr<core::BoundedQueue<KeyFrameJob>> m_mappingQueue, m_loopQueue;
 	std::thread m_mapping, m_loopClosing;
 };
