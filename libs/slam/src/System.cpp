@@ -1,6 +1,7 @@
 #include <keygrid/slam/System.h>
 
 #include <chrono>
+#include <exception>
 #include <stdexcept>
 
 namespace keygrid::slam
@@ -168,7 +169,8 @@ void System::waitForMapping()
 
 void System::mappingThread()
 {
-	// Counts a job as mapped however its processing ends, so that tracking never waits forever.
+	// A job counts as mapped once processed or skipped; if it throws, setBackgroundError wakes
+	// a waiting tracker instead.
 	const auto jobDone = [this]
 	{
 		{
@@ -291,26 +293,49 @@ void System::finish()
 	const auto t1 = std::chrono::steady_clock::now();
 	const auto base = trajectory();
 	m_refined.assign(m_frames.size(), std::nullopt);
-	for (std::size_t i = 0; i < m_frames.size(); i++)
+	// Frames are independent: two workers (every other frame each) read the map and write only
+	// their own m_refined entries, so the result does not depend on scheduling.
+	const sfm::SparseMap& map = m_map;
+	const auto refine = [&](std::size_t first)
 	{
-		const auto& f = m_frames[i];
-		if (!f.tracked) continue;
-		// A keyframe keeps its pose from the (global) bundle adjustment: that joint estimate
-		// beats a pose-only one against points it helped place (measured in doc/evaluation.md).
-		if (f.newKeyFrame && m_map.hasKeyFrame(f.keyframe)) continue;
-		std::vector<sfm::PoseObservation> obs;
-		for (std::size_t k = 0; k < f.observations.size(); k++)
+		for (std::size_t i = first; i < m_frames.size(); i += 2)
 		{
-			if (!m_map.hasLandmark(f.observedLandmarks[k])) continue;
-			auto ob = f.observations[k];
-			ob.p_world = m_map.landmark(f.observedLandmarks[k]).p_world;
-			obs.push_back(ob);
+			const auto& f = m_frames[i];
+			if (!f.tracked) continue;
+			// A keyframe keeps its pose from the (global) bundle adjustment: that joint estimate
+			// beats a pose-only one against points it helped place (measured in doc/evaluation.md).
+			if (f.newKeyFrame && map.hasKeyFrame(f.keyframe)) continue;
+			std::vector<sfm::PoseObservation> obs;
+			for (std::size_t k = 0; k < f.observations.size(); k++)
+			{
+				if (!map.hasLandmark(f.observedLandmarks[k])) continue;
+				auto ob = f.observations[k];
+				ob.p_world = map.landmark(f.observedLandmarks[k]).p_world;
+				obs.push_back(ob);
+			}
+			if (static_cast<int>(obs.size()) < m_cfg.tracker.minInliers) continue;
+			auto T = base[i].T_world_cam;
+			const auto r = sfm::optimizePose(T, obs, *m_K, m_cfg.tracker.pose);
+			if (r.inliers >= m_cfg.tracker.minInliers) m_refined[i] = T;
 		}
-		if (static_cast<int>(obs.size()) < m_cfg.tracker.minInliers) continue;
-		auto T = base[i].T_world_cam;
-		const auto r = sfm::optimizePose(T, obs, *m_K, m_cfg.tracker.pose);
-		if (r.inliers >= m_cfg.tracker.minInliers) m_refined[i] = T;
-	}
+	};
+	std::exception_ptr failed[2];
+	const auto guarded = [&](std::size_t first)
+	{
+		try
+		{
+			refine(first);
+		}
+		catch (...)
+		{
+			failed[first] = std::current_exception();
+		}
+	};
+	std::thread second(guarded, 1);
+	guarded(0);
+	second.join();
+	for (const auto& e : failed)
+		if (e) std::rethrow_exception(e);
 	m_timings.add("frame_refinement", secondsSince(t1));
 }
 
