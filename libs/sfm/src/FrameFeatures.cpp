@@ -43,15 +43,12 @@ std::vector<int> FrameFeatures::featuresInArea(float u, float v, float r, int mi
 	return out;
 }
 
-float descriptorDistance(const cv::Mat& a, const cv::Mat& b)
+float descriptorDistance(const cv::Mat& a, const cv::Mat& b) { return descriptorDistance(a, 0, b, 0); }
+
+float descriptorDistance(const cv::Mat& a, int ra, const cv::Mat& b, int rb)
 {
-	if (a.type() == CV_8U)
-	{
-		const auto* pa = a.ptr<uint64_t>();
-		const auto* pb = b.ptr<uint64_t>();
-		return static_cast<float>(core::hammingDistance(pa, pb, a.cols / 8));
-	}
-	return static_cast<float>(cv::norm(a, b, cv::NORM_L2));
+	if (a.type() == CV_8U) return static_cast<float>(core::hammingDistance(a.ptr<uint64_t>(ra), b.ptr<uint64_t>(rb), a.cols / 8));
+	return static_cast<float>(cv::norm(a.row(ra), b.row(rb), cv::NORM_L2));
 }
 
 }  // namespace keygrid::sfm

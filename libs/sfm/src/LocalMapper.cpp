@@ -183,7 +183,7 @@ void LocalMapper::fuseInto(
 		{
 			const float d = f.depth[i];
 			if (d > 0 && std::abs(d - p.depth) > m_matcher.maxDepthError * p.depth) continue;
-			const float dist = descriptorDistance(lm.descriptor, f.descriptors.row(i));
+			const float dist = descriptorDistance(lm.descriptor, 0, f.descriptors, i);
 			if (dist < bestD)
 			{
 				bestD = dist;

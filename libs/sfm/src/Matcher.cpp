@@ -1,10 +1,8 @@
-#include <keygrid/core/Hamming.h>
 #include <keygrid/sfm/Matcher.h>
 #include <opencv2/features2d.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 
 namespace keygrid::sfm
@@ -47,14 +45,9 @@ int searchByProjection(
 	const MatcherOptions& o, std::vector<LandmarkId>& matches)
 {
 	const float maxDist = o.maxDistance(f.isBinary());
-	// ORB rows compared in place (no cv::Mat header per pair); other descriptors by descriptorDistance.
-	const bool rawRows = f.isBinary() && f.descriptors.cols % 8 == 0 && f.descriptors.isContinuous();
-	const int words = f.descriptors.cols / 8;
 	int added = 0;
 	for (const auto& c : cands)
 	{
-		const bool raw = rawRows && c.descriptor->isContinuous() && c.descriptor->type() == CV_8U &&
-			c.descriptor->cols == f.descriptors.cols;
 		const float r = radius * static_cast<float>(f.levelScale.empty() ? 1.0 : f.levelScale[c.predictedLevel]);
 		const auto idx = f.featuresInArea(c.u, c.v, r, std::max(0, c.predictedLevel - 1), c.predictedLevel + 1);
 		float best = 1e30f, second = 1e30f;
@@ -64,9 +57,7 @@ int searchByProjection(
 			if (matches[i] != kNoLandmark) continue;
 			const float d = f.depth[i];
 			if (d > 0 && std::abs(d - c.depth) > o.maxDepthError * c.depth) continue;
-			const float dist = raw ? static_cast<float>(core::hammingDistance(
-										 c.descriptor->ptr<std::uint64_t>(), f.descriptors.ptr<std::uint64_t>(i), words))
-								   : descriptorDistance(*c.descriptor, f.descriptors.row(i));
+			const float dist = descriptorDistance(*c.descriptor, 0, f.descriptors, i);
 			if (dist < best)
 			{
 				second = best;
@@ -117,25 +108,13 @@ std::vector<std::pair<int, int>> matchSubsetBruteForce(
 	std::vector<std::pair<int, int>> out;
 	const int na = a.descriptors.rows, nb = b.descriptors.rows;
 	if (ia.empty() || nb == 0) return out;
-	// Binary descriptors (whole 64-bit words, continuous rows): Hamming distance on the raw
-	// rows, which avoids a cv::Mat header per pair; otherwise descriptorDistance.
-	const bool raw = a.descriptors.type() == CV_8U && a.descriptors.cols % 8 == 0 && a.descriptors.isContinuous() &&
-		b.descriptors.isContinuous() && b.descriptors.type() == CV_8U && b.descriptors.cols == a.descriptors.cols;
-	const int words = a.descriptors.cols / 8;
-	const auto distance = [&](const cv::Mat& da, int ra, const cv::Mat& db, int rb) -> float
-	{
-		if (!raw) return descriptorDistance(da.row(ra), db.row(rb));
-		const auto* pa = da.ptr<std::uint64_t>(ra);
-		const auto* pb = db.ptr<std::uint64_t>(rb);
-		return static_cast<float>(core::hammingDistance(pa, pb, words));
-	};
 	for (int i : ia)
 	{
 		int best = -1;
 		float d1 = std::numeric_limits<float>::max(), d2 = d1;
 		for (int j = 0; j < nb; j++)
 		{
-			const float d = distance(a.descriptors, i, b.descriptors, j);
+			const float d = descriptorDistance(a.descriptors, i, b.descriptors, j);
 			if (d < d1)
 			{
 				d2 = d1;
@@ -151,7 +130,7 @@ std::vector<std::pair<int, int>> matchSubsetBruteForce(
 		for (int k = 0; k < na && mutual; k++)
 		{
 			if (k == i) continue;
-			const float d = distance(a.descriptors, k, b.descriptors, best);
+			const float d = descriptorDistance(a.descriptors, k, b.descriptors, best);
 			if (d < d1 || (d == d1 && k < i)) mutual = false;
 		}
 		if (mutual) out.emplace_back(i, best);

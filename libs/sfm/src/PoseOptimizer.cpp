@@ -74,11 +74,13 @@ PoseOptimizerResult optimizePose(
 	res.inlier.assign(n, 1);
 
 	auto useDepth = [&](const PoseObservation& ob) { return ob.depth > 0 && ob.depth < o.maxDepthForRgbd; };
+	// chi2 of an observation whose point is not in front of the camera (never an inlier).
+	constexpr double kBehindCamera = 1e30;
 	// Squared residual of one observation at the current estimate (no robust loss).
 	auto chi2 = [&](const PoseObservation& ob) {
 		double u, v, ur;
 		const double p[3] = {ob.p_world.x(), ob.p_world.y(), ob.p_world.z()};
-		if (!projectRgbd(q, t, p, K, o.bf, u, v, ur)) return 1e30;
+		if (!projectRgbd(q, t, p, K, o.bf, u, v, ur)) return kBehindCamera;
 		const double du = (ob.uv.x() - u) * ob.invSigma, dv = (ob.uv.y() - v) * ob.invSigma;
 		double e = du * du + dv * dv;
 		if (useDepth(ob))
@@ -91,7 +93,7 @@ PoseOptimizerResult optimizePose(
 
 	// A point behind the camera at the initial pose would make Ceres stop at its first
 	// evaluation: such observations start as outliers (they may come back after a round).
-	for (std::size_t i = 0; i < n; i++) res.inlier[i] = chi2(obs[i]) < 1e30;
+	for (std::size_t i = 0; i < n; i++) res.inlier[i] = chi2(obs[i]) < kBehindCamera;
 
 	ceres::Solver::Options so;
 	so.linear_solver_type = ceres::DENSE_QR;

@@ -1,7 +1,7 @@
 #include <keygrid/slam/System.h>
 
 #include <chrono>
-#include <exception>
+#include <future>
 #include <stdexcept>
 
 namespace keygrid::slam
@@ -185,16 +185,11 @@ void System::mappingThread()
 		{
 			std::unique_lock<std::mutex> lock(m_map.mutex());
 			// A keyframe still queued may have been culled as redundant meanwhile.
-			if (!m_map.hasKeyFrame(job->keyframe))
-			{
-				lock.unlock();
-				jobDone();
-				continue;
-			}
-			mapKeyFrame(*job, &lock);
+			const bool exists = m_map.hasKeyFrame(job->keyframe);
+			if (exists) mapKeyFrame(*job, &lock);
 			lock.unlock();
 			jobDone();
-			if (!m_loopQueue->push(*job)) break;
+			if (exists && !m_loopQueue->push(*job)) break;
 		}
 	}
 	catch (const std::exception& e)
@@ -308,9 +303,10 @@ void System::finish()
 			std::vector<sfm::PoseObservation> obs;
 			for (std::size_t k = 0; k < f.observations.size(); k++)
 			{
-				if (!map.hasLandmark(f.observedLandmarks[k])) continue;
+				const sfm::Landmark* lm = map.findLandmark(f.observedLandmarks[k]);
+				if (!lm) continue;
 				auto ob = f.observations[k];
-				ob.p_world = map.landmark(f.observedLandmarks[k]).p_world;
+				ob.p_world = lm->p_world;
 				obs.push_back(ob);
 			}
 			if (static_cast<int>(obs.size()) < m_cfg.tracker.minInliers) continue;
@@ -319,23 +315,10 @@ void System::finish()
 			if (r.inliers >= m_cfg.tracker.minInliers) m_refined[i] = T;
 		}
 	};
-	std::exception_ptr failed[2];
-	const auto guarded = [&](std::size_t first)
-	{
-		try
-		{
-			refine(first);
-		}
-		catch (...)
-		{
-			failed[first] = std::current_exception();
-		}
-	};
-	std::thread second(guarded, 1);
-	guarded(0);
-	second.join();
-	for (const auto& e : failed)
-		if (e) std::rethrow_exception(e);
+	// std::async's future joins in its destructor and passes an exception on through get().
+	auto second = std::async(std::launch::async, refine, std::size_t{1});
+	refine(0);
+	second.get();
 	m_timings.add("frame_refinement", secondsSince(t1));
 }
 

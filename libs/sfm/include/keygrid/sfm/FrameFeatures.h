@@ -43,5 +43,8 @@ struct FrameFeatures
 
 /** Distance between two descriptors: Hamming for binary, L2 for float. */
 float descriptorDistance(const cv::Mat& a, const cv::Mat& b);
+/** The same between row `ra` of `a` and row `rb` of `b`, without building a cv::Mat header per
+ * row (matching loops call this for every candidate pair). */
+float descriptorDistance(const cv::Mat& a, int ra, const cv::Mat& b, int rb);
 
 }  // namespace keygrid::sfm

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <map>
 #include <mutex>
+#include <utility>
 #include <vector>
 
 namespace keygrid::sfm
@@ -98,11 +99,12 @@ class SparseMap
 	const KeyFrame& keyframe(KeyFrameId id) const { return m_keyframes.at(id); }
 	Landmark& landmark(LandmarkId id) { return m_landmarks.at(id); }
 	/** The landmark, or nullptr when it does not exist (one lookup instead of has + get). */
-	Landmark* findLandmark(LandmarkId id)
+	const Landmark* findLandmark(LandmarkId id) const
 	{
 		const auto it = m_landmarks.find(id);
 		return it == m_landmarks.end() ? nullptr : &it->second;
 	}
+	Landmark* findLandmark(LandmarkId id) { return const_cast<Landmark*>(std::as_const(*this).findLandmark(id)); }
 	const Landmark& landmark(LandmarkId id) const { return m_landmarks.at(id); }
 	const std::map<KeyFrameId, KeyFrame>& keyframes() const { return m_keyframes; }
 	const std::map<LandmarkId, Landmark>& landmarks() const { return m_landmarks; }
