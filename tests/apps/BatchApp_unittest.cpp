@@ -42,6 +42,7 @@ std::string experiment(const std::string& extra = "", const std::string& line = 
 		dataDir() + "/sim/room_arc.ini\n" +
 		"seed = 7\n"
 		"frames = 30\n"
+		"set = sensor.disparity_distortion=0.1\n"
 		"\n"
 		"[config.base]\n"
 		"file = " +
@@ -119,6 +120,8 @@ TEST(BatchExperiment, ParsesValidFile)
 	EXPECT_TRUE(spec.datasets[1].generated());
 	EXPECT_EQ(spec.datasets[1].seed.value_or(-1), 7);
 	EXPECT_EQ(spec.datasets[1].frames.value_or(-1), 30);
+	EXPECT_EQ(spec.datasets[1].simSet, "sensor.disparity_distortion=0.1");
+	EXPECT_TRUE(spec.datasets[0].simSet.empty());
 	ASSERT_EQ(spec.configs.size(), 2u);
 	EXPECT_EQ(spec.configs[0].name, "base");
 	EXPECT_TRUE(spec.configs[0].overrides.empty());
@@ -150,6 +153,8 @@ TEST(BatchExperiment, EveryInvalidKeyOrValueFailsNamingIt)
 		{"input = some/folder", "input = some/folder\nscene = x.ini", "", "[dataset.recorded]"},
 		{"input = some/folder", "", "", "[dataset.recorded]"},
 		{"max_frames = 40", "seed = 3", "", "seed"},
+		{"max_frames = 40", "set = sensor.noise=false", "", "set"},
+		{"set = sensor.disparity_distortion=0.1", "set = sensor.noise", "", "sensor.noise"},
 		{"/sim/room_arc.ini", "/sim/no_such_scene.ini", "", "no_such_scene.ini"},
 		{"set = loop_closing.enabled=false ;", "set = loop_closing.enabled ;", "", "loop_closing.enabled"},
 		{"set = loop_closing.enabled=false ;", "set = enabled=false ;", "", "enabled=false"},
@@ -318,7 +323,8 @@ TEST(BatchApp, RunsMatrixAndReportsAteAsKeygridEval)
 	const std::string out = keygrid::test::scratchDir("batch_matrix");
 	const std::string expPath = out + "/experiment.ini";
 	std::ofstream(expPath) << "[batch]\noutput = " << out << "/results\njobs = 2\n\n"
-						   << "[dataset.arc]\nscene = " << dataDir() << "/sim/room_arc.ini\nframes = 30\n\n"
+						   << "[dataset.arc]\nscene = " << dataDir() << "/sim/room_arc.ini\nframes = 30\n"
+						   << "set = sensor.image_noise_sigma=1.5\n\n"
 						   << "[dataset.missing]\ninput = " << out << "/no_such_sequence.rawlog\n\n"
 						   << "[config.default]\nfile = " << sourceDir() << "/config/sim.ini\n\n"
 						   << "[config.fewer_features]\nfile = " << sourceDir() << "/config/sim.ini\n"
@@ -371,6 +377,8 @@ TEST(BatchApp, RunsMatrixAndReportsAteAsKeygridEval)
 	EXPECT_TRUE(SlamConfig::FromFile(out + "/results/_configs/default.ini").loop.enabled);
 	EXPECT_NE(keygrid::test::readTextFile(out + "/results/results.md").find("| arc | default | 1/1 | 30 |"), std::string::npos);
 	EXPECT_EQ(readCsv(out + "/results/runs.csv").size(), 5u);
+	// The dataset's scene overrides went to keygrid-sim.
+	EXPECT_NE(keygrid::test::readTextFile(out + "/results/results.md").find("--frames 30 --set 'sensor.image_noise_sigma=1.5'`"), std::string::npos);
 }
 
 TEST(BatchApp, BadCommandLinesAndSpecsFailWithOneLine)

@@ -113,6 +113,43 @@ TEST(SensorModel, DisparityQuantisationRangeAndGrazingLimits)
 	}
 }
 
+TEST(SensorModel, DisparityDistortionFollowsTheRadialClosedForm)
+{
+	// Noise off, k = 0.4 px: z' = f B / (f B / z - k rho^2) with rho^2 = r^2 / r_corner^2 from
+	// the image centre. Centre pixel of an odd-sized image unchanged, corners the largest
+	// error, and a pixel halfway along the diagonal gets rho^2 = 1/4.
+	sim::SensorOptions o;
+	o.noise = false;
+	o.maxIncidenceDeg = 90;
+	o.maxRange = 20;
+	o.disparityDistortion = 0.4;
+	const double f = 525, fB = f * o.baseline;
+	const sim::SensorModel model(o, f, 7, 1);
+	const int W = 81, H = 61;
+	const double cx = 40, cy = 30, z = 3.0;
+	cv::Mat depth(H, W, CV_32FC1, cv::Scalar(z)), cosI(H, W, CV_32FC1, cv::Scalar(1.0f)), out;
+	cv::Mat colour(H, W, CV_8UC3, cv::Scalar(0, 0, 0));
+	model.apply(0, depth, cosI, out, colour);
+	const auto expected = [&](int u, int v) {
+		const double rho2 = ((u - cx) * (u - cx) + (v - cy) * (v - cy)) / (cx * cx + cy * cy);
+		return fB / (fB / z - 0.4 * rho2);
+	};
+	EXPECT_FLOAT_EQ(out.at<float>(30, 40), static_cast<float>(z));
+	EXPECT_NEAR(out.at<float>(0, 0), fB / (fB / z - 0.4), 1e-5);
+	EXPECT_NEAR(out.at<float>(H - 1, W - 1), fB / (fB / z - 0.4), 1e-5);
+	EXPECT_NEAR(out.at<float>(15, 20), fB / (fB / z - 0.1), 1e-5);  // rho^2 = 1/4
+	// 3 m at the corner: 3 * 0.4 * 3 / 39.375 = 3.1 % deeper.
+	EXPECT_NEAR(out.at<float>(0, 0) / z - 1, 0.4 * z / fB, 0.002);
+	for (int v = 0; v < H; v += 7)
+		for (int u = 0; u < W; u += 5) ASSERT_NEAR(out.at<float>(v, u), expected(u, v), 1e-5);
+	// A disparity offset larger than the disparity itself leaves no valid depth.
+	o.disparityDistortion = 20;  // > f B / 3 m = 13.1 px at the corners
+	const sim::SensorModel strong(o, f, 7, 1);
+	strong.apply(0, depth, cosI, out, colour);
+	EXPECT_EQ(out.at<float>(0, 0), 0.0f);
+	EXPECT_FLOAT_EQ(out.at<float>(30, 40), static_cast<float>(z));
+}
+
 TEST(SensorModel, OptionsRejectBadValuesNamingTheKey)
 {
 	const std::string ini = test::wallSceneIni(2.0, "max_range = -1");
@@ -140,6 +177,7 @@ TEST(SensorModel, OptionStructsRoundTripThroughIni)
 	s.maxRange = 3.5;
 	s.maxIncidenceDeg = 70;
 	s.dropoutProbability = 0.01;
+	s.disparityDistortion = 0.15;
 	sim::OutputOptions o;
 	o.writeMask = true;
 	o.voxelResolution = 0.1;
@@ -165,6 +203,7 @@ TEST(SensorModel, OptionStructsRoundTripThroughIni)
 	EXPECT_DOUBLE_EQ(s2.maxRange, 3.5);
 	EXPECT_DOUBLE_EQ(s2.maxIncidenceDeg, 70);
 	EXPECT_DOUBLE_EQ(s2.dropoutProbability, 0.01);
+	EXPECT_DOUBLE_EQ(s2.disparityDistortion, 0.15);
 	EXPECT_TRUE(o2.writeMask);
 	EXPECT_DOUBLE_EQ(o2.voxelResolution, 0.1);
 	EXPECT_DOUBLE_EQ(o2.floorPlanZMax, 2.0);

@@ -94,6 +94,33 @@ TEST(SequenceOutputs, ToolNeverWritesIntoTheSceneFile)
 	EXPECT_EQ(slurp(scene), before);
 }
 
+TEST(SequenceOutputs, SetOverridesSceneKeysLikeTheFileWould)
+{
+	// --set section.key=value gives the same bytes as the key written into the scene file, and
+	// a misspelt key is an error naming it (MRPT would ignore it silently).
+	const std::string plain = writeScene("sim_set_plain", tinyRoomIni(5));
+	const std::string edited = writeScene(
+		"sim_set_edited", tinyRoomIni(5) + "[sensor]\ndisparity_distortion = 0.5\n");
+	const std::string tool = test::toolPath("keygrid-sim") + " --quiet --frames 2 ";
+	const std::string a = test::scratchDir("sim_set_a"), b = test::scratchDir("sim_set_b"),
+					  c = test::scratchDir("sim_set_c");
+	std::string log;
+	ASSERT_EQ(test::runCommand(tool + "--set 'sensor.disparity_distortion=0.5' --scene " + plain + " --output " + a, &log), 0) << log;
+	ASSERT_EQ(test::runCommand(tool + "--scene " + edited + " --output " + b, &log), 0) << log;
+	ASSERT_EQ(test::runCommand(tool + "--scene " + plain + " --output " + c, &log), 0) << log;
+	const std::vector<std::string> depth = listFiles(a + "/tum/depth");
+	ASSERT_EQ(depth.size(), 2u);
+	for (const std::string& f : depth)
+	{
+		EXPECT_EQ(slurp(a + "/tum/depth/" + f), slurp(b + "/tum/depth/" + f)) << f;
+		EXPECT_NE(slurp(a + "/tum/depth/" + f), slurp(c + "/tum/depth/" + f)) << f;
+	}
+	EXPECT_NE(test::runCommand(tool + "--set 'sensor.disparity_distorsion=0.5' --scene " + plain + " --output " + a, &log), 0);
+	EXPECT_NE(log.find("disparity_distorsion"), std::string::npos) << log;
+	EXPECT_NE(test::runCommand(tool + "--set 'sensor.noise' --scene " + plain + " --output " + a, &log), 0);
+	EXPECT_NE(log.find("--set"), std::string::npos) << log;
+}
+
 TEST(SequenceOutputs, ToolOutputsAreReadable)
 {
 	const std::string scene = writeScene("sim_tool_in", tinyRoomIni(9));

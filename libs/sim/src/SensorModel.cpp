@@ -27,6 +27,8 @@ void SensorOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
 	maxIncidenceDeg = ini::readDouble(c, s, "max_incidence_deg", maxIncidenceDeg, 0, 90);
 	dropoutProbability = ini::readDouble(c, s, "dropout_probability", dropoutProbability, 0, 1);
 	imageNoiseSigma = ini::readDouble(c, s, "image_noise_sigma", imageNoiseSigma, 0, 100);
+	disparityDistortion =
+		ini::readDouble(c, s, "disparity_distortion", disparityDistortion, -5, 5);
 	try
 	{
 		validate();
@@ -51,6 +53,7 @@ void SensorOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std
 	c.write(s, "max_incidence_deg", maxIncidenceDeg);
 	c.write(s, "dropout_probability", dropoutProbability);
 	c.write(s, "image_noise_sigma", imageNoiseSigma);
+	c.write(s, "disparity_distortion", disparityDistortion);
 }
 
 void SensorOptions::validate() const
@@ -84,6 +87,12 @@ double SensorModel::quantise(double z) const
 	const double s = m_opts.disparitySubpixel;
 	const double steps = std::round(s * m_fB / z);
 	return steps > 0 ? m_fB * s / steps : 0.0;
+}
+
+double SensorModel::distort(double z, double rho2) const
+{
+	const double d = m_fB / z - m_opts.disparityDistortion * rho2;
+	return d > 0 ? m_fB / d : 0.0;
 }
 
 namespace
@@ -134,6 +143,9 @@ void SensorModel::apply(
 	const std::uint64_t dropBelow =
 		static_cast<std::uint64_t>(std::llround(m_opts.dropoutProbability * 65536.0));
 	const float imgSigma = static_cast<float>(m_opts.imageNoiseSigma);
+	const bool distorted = m_opts.disparityDistortion != 0;
+	const double cx = 0.5 * (W - 1), cy = 0.5 * (trueDepth.rows - 1);
+	const double invHalfDiag2 = 1.0 / (cx * cx + cy * cy);
 	parallelRows(trueDepth.rows, m_threads, [&](int r0, int r1) {
 		for (int y = r0; y < r1; y++)
 		{
@@ -150,7 +162,9 @@ void SensorModel::apply(
 				double z = zt[x];
 				const bool valid =
 					z > 0 && z >= m_opts.minRange && z <= m_opts.maxRange && ci[x] >= m_cosMin;
-				if (!valid)
+				if (valid && distorted)
+					z = distort(z, ((x - cx) * (x - cx) + (y - cy) * (y - cy)) * invHalfDiag2);
+				if (!valid || !(z > 0))
 					z = 0;
 				else if (noisy)
 				{

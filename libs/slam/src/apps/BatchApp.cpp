@@ -190,6 +190,7 @@ std::vector<RunMetrics> runBatch(const ExperimentSpec& spec, const BatchRunOptio
 		job.argv = {simExe, "--scene", d.scene, "--output", dir.string(), "--quiet"};
 		if (d.seed) job.argv.insert(job.argv.end(), {"--seed", std::to_string(*d.seed)});
 		if (d.frames) job.argv.insert(job.argv.end(), {"--frames", std::to_string(*d.frames)});
+		if (!d.simSet.empty()) job.argv.insert(job.argv.end(), {"--set", d.simSet});
 		job.logPath = (dir / "keygrid-sim.log").string();
 		const std::string stamp = commandText(job.argv) + "\nscene text hash " +
 								  std::to_string(std::hash<std::string>{}(mrpt::io::file_get_contents(d.scene))) + "\n";
@@ -313,7 +314,8 @@ std::vector<RunMetrics> runBatch(const ExperimentSpec& spec, const BatchRunOptio
 	for (const auto& d : spec.datasets)
 		md << "* dataset `" << d.name << "`: "
 		   << (d.generated() ? "`keygrid-sim --scene " + d.scene + (d.seed ? " --seed " + std::to_string(*d.seed) : "") +
-								   (d.frames ? " --frames " + std::to_string(*d.frames) : "") + "`"
+								   (d.frames ? " --frames " + std::to_string(*d.frames) : "") +
+								   (d.simSet.empty() ? "" : " --set '" + d.simSet + "'") + "`"
 							 : "`" + d.input + "`")
 		   << (d.maxFrames > 0 ? ", first " + std::to_string(d.maxFrames) + " frames" : "") << "\n";
 	for (const auto& c : spec.configs)

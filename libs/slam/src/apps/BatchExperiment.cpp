@@ -181,7 +181,7 @@ ExperimentSpec ExperimentSpec::FromText(const std::string& text, const std::stri
 			throw std::invalid_argument(origin + ":" + std::to_string(s.line) + ": [" + s.name + "]: the name must be letters, digits, '_', '-' or '.', starting with a letter or digit");
 		if (kind == "dataset")
 		{
-			SectionReader r(s, origin, {"input", "gt", "scene", "seed", "frames", "max_frames"});
+			SectionReader r(s, origin, {"input", "gt", "scene", "seed", "frames", "set", "max_frames"});
 			DatasetSpec d;
 			d.name = name;
 			d.input = r.str("input");
@@ -189,10 +189,22 @@ ExperimentSpec ExperimentSpec::FromText(const std::string& text, const std::stri
 			d.scene = r.str("scene");
 			d.seed = r.integer("seed", 0, 4294967295L);
 			d.frames = r.integer("frames", 1, 10000000L);
+			d.simSet = r.str("set");
+			if (!d.simSet.empty())
+			{
+				try
+				{
+					parseOverrides(d.simSet, "set");  // syntax now; keygrid-sim checks the keys
+				}
+				catch (const std::invalid_argument& ex)
+				{
+					r.fail(*r.find("set"), ex.what());
+				}
+			}
 			d.maxFrames = r.integer("max_frames", 0, 10000000L).value_or(0);
 			if (d.input.empty() == d.scene.empty()) r.failSection("needs exactly one of input = (a recorded sequence) or scene = (keygrid-sim generates it)");
-			if (!d.generated() && (d.seed || d.frames))
-				r.fail(*r.find(d.seed ? "seed" : "frames"), "only with scene = (keygrid-sim options)");
+			if (!d.generated() && (d.seed || d.frames || !d.simSet.empty()))
+				r.fail(*r.find(d.seed ? "seed" : d.frames ? "frames" : "set"), "only with scene = (keygrid-sim options)");
 			if (d.generated() && !mrpt::system::fileExists(d.scene)) r.fail(*r.find("scene"), "file '" + d.scene + "' does not exist");
 			spec.datasets.push_back(d);
 		}

@@ -4,6 +4,7 @@
 #include <keygrid/sim/Scene.h>
 #include <keygrid/sim/SequenceWriter.h>
 #include <keygrid/slam/apps/AppRunner.h>
+#include <keygrid/slam/apps/BatchExperiment.h>
 #include <keygrid/slam/apps/SimApp.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/vector_loadsave.h>
@@ -45,6 +46,10 @@ int SimApp::run(int argc, const char* const* argv)
 			.option(
 				"camera", "PRESET|FILE.ini", "camera of the --augment folder", false,
 				"from the folder")
+			.option(
+				"set", "SECTION.KEY=V[;...]",
+				"override scene keys, e.g. 'sensor.disparity_distortion=0.3' (unknown keys are "
+				"errors)")
 			.flag("no-noise", "exact depth and images: [sensor] noise = false")
 			.flag("mask", "also write DIR/tum/mask/ (255 = dynamic object pixel)")
 			.flag("quiet", "no progress output");
@@ -65,7 +70,19 @@ int SimApp::run(int argc, const char* const* argv)
 		// The INI is only read: overrides (--seed) go to an in-memory copy. (An
 		// mrpt::config::CConfigFile would write them back into the user's scene file on
 		// destruction; discardSavingChanges() is undone by any later write().)
-		mrpt::config::CConfigFileMemory cfg(mrpt::io::file_get_contents(scenePath));
+		std::string sceneText = mrpt::io::file_get_contents(scenePath);
+		if (cl.has("set"))
+		{
+			try
+			{
+				sceneText = applyOverrides(sceneText, parseOverrides(cl.get("set"), "--set"));
+			}
+			catch (const std::invalid_argument& e)
+			{
+				throw core::CommandLineError(e.what());
+			}
+		}
+		mrpt::config::CConfigFileMemory cfg(sceneText);
 		if (cl.has("seed"))
 		{
 			const long seed = cl.getInt("seed");

@@ -7,7 +7,14 @@
  *   1/s pixel, so z is rounded to f B / (round(s f B / z) / s);
  * - invalid pixels (depth 0) outside [minRange, maxRange] and where the ray meets the surface
  *   at more than maxIncidence from its normal (grazing angles);
- * - random dropouts and additive Gaussian image noise.
+ * - random dropouts and additive Gaussian image noise;
+ * - optionally, a fixed-pattern disparity distortion (off by default): an uncalibrated Kinect
+ *   measures disparity with a systematic, spatially varying offset that grows towards the image
+ *   borders (Smisek, Jancosek, Pajdla 2011; Herrera, Kannala, Heikkila 2012). Modelled as
+ *   d' = d - k rho^2, rho = distance from the image centre / half diagonal, so
+ *   z' = f B / (f B / z - k rho^2): a relative depth error k rho^2 z / (f B) that grows with
+ *   range. Unlike the per-pixel noise it does not average out over many points, so it makes
+ *   visual odometry drift as real Kinect data does.
  * Randomness is a pure function of (seed, frame index, pixel): same seed -> same bytes.
  */
 #include <opencv2/core/mat.hpp>
@@ -45,6 +52,9 @@ struct SensorOptions
 	double dropoutProbability{0.002};
 	/** Standard deviation of additive image noise [grey levels] (Default: 2.0) */
 	double imageNoiseSigma{2.0};
+	/** Fixed-pattern disparity distortion k [px]: the disparity offset at the image corners
+	 * (see the file comment); applied also with noise off; 0 disables (Default: 0) */
+	double disparityDistortion{0.0};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
@@ -64,6 +74,9 @@ class SensorModel
 	double sigma(double z) const;
 	/** Depth rounded to the nearest representable disparity. */
 	double quantise(double z) const;
+	/** Depth after the fixed-pattern disparity distortion at normalised radius rho (0 at the
+	 * image centre, 1 at the corners); 0 when the distorted disparity is not positive. */
+	double distort(double z, double rho2) const;
 
 	/** trueDepth (CV_32F, 0 = no surface) and cosIncidence (CV_32F, |cos| between ray and
 	 * normal) -> measured depth (CV_32F, 0 = invalid). Adds image noise to colour (CV_8UC3) in

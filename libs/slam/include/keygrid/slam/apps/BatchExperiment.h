@@ -37,6 +37,8 @@ struct DatasetSpec
 	/** keygrid-sim scene INI: the sequence is generated into OUT/_datasets/NAME first */
 	std::string scene;
 	std::optional<long> seed, frames;  //!< keygrid-sim --seed / --frames
+	/** keygrid-sim --set: scene overrides `section.key=value; ...` (e.g. sensor options) */
+	std::string simSet;
 	/** keygrid-slam --max-frames (Default: 0 = all) */
 	long maxFrames{0};
 
