@@ -74,8 +74,9 @@ class SensorModel
 	double sigma(double z) const;
 	/** Depth rounded to the nearest representable disparity. */
 	double quantise(double z) const;
-	/** Depth after the fixed-pattern disparity distortion at normalised radius rho (0 at the
-	 * image centre, 1 at the corners); 0 when the distorted disparity is not positive. */
+	/** Depth after the fixed-pattern disparity distortion, given rho2 = rho^2, the squared
+	 * normalised radius (0 at the image centre, 1 at the corners); 0 when the distorted
+	 * disparity is not positive. */
 	double distort(double z, double rho2) const;
 
 	/** trueDepth (CV_32F, 0 = no surface) and cosIncidence (CV_32F, |cos| between ray and
