@@ -174,3 +174,53 @@ TEST(SlamApp, UnknownKeysOfSlamSectionsAreNamedAndShippedConfigsAreClean)
 	std::ofstream(dir + "/other.ini") << "[MappingApplication]\npointsMap_count = 1\n[custom]\nanything = 1\n";
 	EXPECT_NO_THROW(slam::SlamConfig::FromFile(dir + "/other.ini"));
 }
+
+TEST(SlamApp, SetOverridesKeysLikeTheFileWouldAndRejectsUnknownOnes)
+{
+	const std::string dir = test::scratchDir("slam_set");
+	const std::string tool = test::toolPath("keygrid-slam");
+	const std::string base = test::sourceDir() + "/config/tum_fr1.ini";
+	std::string out;
+	// Misspelt keys and bad syntax are named, before any input is opened.
+	EXPECT_EQ(test::runCommand(tool + " --config " + base + " --input x --output " + dir + " --set 'featurs.num_features=900'", &out), 1);
+	EXPECT_NE(out.find("featurs.num_features"), std::string::npos) << out;
+	EXPECT_EQ(test::runCommand(tool + " --config " + base + " --input x --output " + dir + " --set 'features.num_feature=900'", &out), 1);
+	EXPECT_NE(out.find("features.num_feature"), std::string::npos) << out;
+	EXPECT_EQ(test::runCommand(tool + " --config " + base + " --input x --output " + dir + " --set 'num_features=900'", &out), 2);
+	EXPECT_NE(out.find("num_features=900"), std::string::npos) << out;
+	// Values go through the same validation as the file's.
+	EXPECT_EQ(test::runCommand(tool + " --config " + base + " --input x --output " + dir + " --set 'features.num_features=3'", &out), 1);
+	EXPECT_NE(out.find("num_features = 3"), std::string::npos) << out;
+	// --dump-config shows the result: a replaced key, and a key of a section the file lacks.
+	ASSERT_EQ(test::runCommand(tool + " --config " + base + " --dump-config --set 'features.num_features=900; hoc.enabled=true' > " + dir + "/dump.ini", &out), 0) << out;
+	const auto dumped = slam::SlamConfig::FromFile(dir + "/dump.ini");
+	EXPECT_EQ(dumped.features.numFeatures, 900);
+	EXPECT_TRUE(dumped.tracker.hoc.enabled);
+	EXPECT_EQ(slam::SlamConfig::FromFile(base).features.numFeatures, 1000) << "the file itself is not modified";
+
+	KEYGRID_SKIP_WITHOUT_SHARED_DATA("tum_fr1_desk_9frames");
+	const std::string desk = test::sharedDataDir() + "/tum_fr1_desk_9frames";
+	// The same run configured by --set and by a file holding the same keys: identical outputs.
+	{
+		std::string text = test::readTextFile(base);
+		text = std::regex_replace(text, std::regex("num_features = 1000"), "num_features = 700");
+		text = std::regex_replace(text, std::regex("\\[tracker\\]\n"), "[tracker]\nmin_inliers = 20\n");
+		ASSERT_NE(text.find("num_features = 700"), std::string::npos);
+		ASSERT_NE(text.find("min_inliers = 20"), std::string::npos);
+		std::ofstream(dir + "/edited.ini") << text;
+	}
+	std::string traj[2];
+	for (int i = 0; i < 2; i++)
+	{
+		slam::SlamRunOptions o;
+		o.configPath = i == 0 ? dir + "/edited.ini" : base;
+		if (i == 1) o.set = "features.num_features = 700; tracker.min_inliers=20";
+		o.input = desk;
+		o.output = dir + "/out" + std::to_string(i);
+		o.quiet = true;
+		EXPECT_EQ(slam::runSlam(o).tracked, 9u);
+		traj[i] = test::readTextFile(o.output + "/trajectory.txt");
+	}
+	EXPECT_EQ(traj[0], traj[1]);
+	EXPECT_NE(test::readTextFile(dir + "/out1/report.json").find("\"config_set\": \"features.num_features = 700; tracker.min_inliers=20\""), std::string::npos);
+}

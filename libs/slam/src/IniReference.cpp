@@ -275,7 +275,7 @@ std::string iniReferenceMarkdown()
 		  "Every key keygrid-slam reads from its INI file, with the default compiled into the options\n"
 		  "struct and the comment its `saveToConfigFile` writes. A key absent from a file keeps this\n"
 		  "default; an invalid value stops the run naming the key and the value.\n"
-		  "`keygrid-slam --dump-config --config FILE.ini` prints the effective configuration of a file.\n"
+		  "`keygrid-slam --dump-config --config FILE.ini [--set 'section.key=value; ...']` prints the effective configuration of a file.\n"
 		  "MRPT's INI reader has no inline comments: put comments on their own lines.\n\n"
 		  "## keygrid-slam\n\n";
 	for (const auto& s : slamConfigReference()) appendTable(md, s, "###");

@@ -4,8 +4,6 @@
 #include <keygrid/slam/LiveRun.h>
 #include <keygrid/slam/OpenNI2FrameSource.h>
 #include <keygrid/slam/System.h>
-#include <mrpt/config/CConfigFile.h>
-#include <mrpt/system/filesystem.h>
 
 #include <chrono>
 #include <cstdio>
@@ -24,12 +22,11 @@ struct Extracted
 };
 }  // namespace
 
-std::unique_ptr<LiveFrameSource> openLiveCamera(const std::string& iniPath, const SlamConfig& cfg)
+std::unique_ptr<LiveFrameSource> openLiveCamera(
+	const mrpt::config::CConfigFileBase& ini, const std::string& origin, const SlamConfig& cfg)
 {
-	if (!mrpt::system::fileExists(iniPath)) throw std::invalid_argument("config file '" + iniPath + "' does not exist");
-	mrpt::config::CConfigFile ini(iniPath);
 	if (!ini.sectionExists("live"))
-		throw std::invalid_argument(iniPath + ": no [live] section (the OpenNI2 sensor settings; see config/kinect_openni2.ini)");
+		throw std::invalid_argument(origin + ": no [live] section (the OpenNI2 sensor settings; see config/kinect_openni2.ini)");
 	OpenNI2SourceOptions so;
 	so.loadFromConfigFile(ini, "live");
 	if (!cfg.camera.empty() && cfg.camera != "auto") so.camera = core::RgbdCamera::FromPresetOrFile(cfg.camera);

@@ -71,7 +71,11 @@ void SlamConfig::checkKnownKeys(const mrpt::config::CConfigFileBase& c)
 SlamConfig SlamConfig::FromFile(const std::string& path)
 {
 	if (!mrpt::system::fileExists(path)) throw std::invalid_argument("config file '" + path + "' does not exist");
-	mrpt::config::CConfigFile cfg(path);
+	return FromConfig(mrpt::config::CConfigFile(path), path);
+}
+
+SlamConfig SlamConfig::FromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& origin)
+{
 	SlamConfig c;
 	try
 	{
@@ -80,7 +84,7 @@ SlamConfig SlamConfig::FromFile(const std::string& path)
 	}
 	catch (const std::exception& e)
 	{
-		throw std::invalid_argument(path + ": " + e.what());
+		throw std::invalid_argument(origin + ": " + e.what());
 	}
 	return c;
 }

@@ -13,9 +13,10 @@
 #include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/System.h>
 #include <keygrid/slam/apps/AppRunner.h>
+#include <keygrid/slam/apps/BatchExperiment.h>
 #include <keygrid/slam/apps/SlamApp.h>
-#include <mrpt/config/CConfigFile.h>
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/vector_loadsave.h>
 #include <mrpt/system/filesystem.h>
 
 #include <chrono>
@@ -57,6 +58,18 @@ std::string jsonEscape(const std::string& s)
 	return o;
 }
 
+/** The configuration file's text with `set` applied (keys checked first: MRPT would ignore a
+ * misspelt one). The file is read once, so every reader sees the same configuration. */
+std::string effectiveConfigText(const std::string& path, const std::string& set)
+{
+	if (!mrpt::system::fileExists(path)) throw std::invalid_argument("config file '" + path + "' does not exist");
+	std::string text = mrpt::io::file_get_contents(path);
+	if (set.empty()) return text;
+	const auto overrides = parseOverrides(set, "--set");
+	checkOverrideKeys(text, overrides, "--set");
+	return applyOverrides(text, overrides);
+}
+
 struct Extracted
 {
 	core::Frame frame;
@@ -67,7 +80,8 @@ struct Extracted
 
 SlamRunResult runSlam(const SlamRunOptions& o)
 {
-	SlamConfig cfg = SlamConfig::FromFile(o.configPath);
+	const mrpt::config::CConfigFileMemory ini(effectiveConfigText(o.configPath, o.set));
+	SlamConfig cfg = SlamConfig::FromConfig(ini, o.configPath);
 	if (o.modeOverride) cfg.mode = *o.modeOverride;
 	if (o.cameraOverride) cfg.camera = *o.cameraOverride;
 	if (cfg.mode != "sequential" && cfg.mode != "threaded")
@@ -86,7 +100,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	std::unique_ptr<core::PrefetchingFrameSource> source;
 	std::unique_ptr<LiveFrameSource> live;
 	if (o.live)
-		live = openLiveCamera(o.configPath, cfg);
+		live = openLiveCamera(ini, o.configPath, cfg);
 	else
 		source = std::make_unique<core::PrefetchingFrameSource>(core::openFrameSource(o.input, so), 4);
 	core::FrameSource& input = live ? static_cast<core::FrameSource&>(*live) : *source;
@@ -95,7 +109,6 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 
 	System sys(cfg);
 	{
-		mrpt::config::CConfigFile ini(o.configPath);
 		auto maps = std::make_unique<MetricMaps>(ini, cfg.maps);
 		if (!maps->empty()) sys.attachMaps(std::move(maps));
 	}
@@ -326,6 +339,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "{\n";
 	js << "  \"input\": \"" << jsonEscape(live ? live->describe() : o.input) << "\",\n";
 	js << "  \"config\": \"" << jsonEscape(o.configPath) << "\",\n";
+	js << "  \"config_set\": " << (o.set.empty() ? "null" : "\"" + jsonEscape(o.set) + "\"") << ",\n";
 	js << "  \"mode\": \"" << cfg.mode << "\",\n";
 	js << "  \"frames\": " << st.frames << ",\n";
 	js << "  \"tracked\": " << st.tracked << ",\n";
@@ -422,6 +436,10 @@ int SlamApp::run(int argc, const char* const* argv)
 			.option("mode", "sequential|threaded", "override [slam] mode")
 			.option("camera", "PRESET|FILE.ini", "override [slam] camera (TUM folders)")
 			.option("max-frames", "N", "stop after N frames", false, "0 (all)")
+			.option(
+				"set", "SECTION.KEY=V[;...]",
+				"override configuration keys without editing the file, e.g. 'hoc.enabled=true; "
+				"features.num_features=1200' (unknown keys are errors)")
 			.flag("quiet", "no progress output")
 			.flag("live", "grab from the OpenNI2 camera (Kinect/Xtion) of the config's [live] section in real time; Ctrl-C ends the run")
 			.flag("preview", "with --live: show the image and tracked keypoints (default when $DISPLAY is set)")
@@ -436,7 +454,10 @@ int SlamApp::run(int argc, const char* const* argv)
 		}
 		if (cl.flagSet("dump-config"))
 		{
-			const SlamConfig c = cl.has("config") ? SlamConfig::FromFile(cl.get("config")) : SlamConfig();
+			if (cl.has("set") && !cl.has("config")) throw core::CommandLineError("--set needs --config");
+			const SlamConfig c = cl.has("config") ? SlamConfig::FromConfig(
+				mrpt::config::CConfigFileMemory(effectiveConfigText(cl.get("config"), cl.has("set") ? cl.get("set") : "")),
+				cl.get("config")) : SlamConfig();
 			mrpt::config::CConfigFileMemory mem;
 			c.saveToConfigFile(mem);
 			std::cout << "# keygrid-slam effective configuration\n" << mem.getContent();
@@ -456,6 +477,18 @@ int SlamApp::run(int argc, const char* const* argv)
 		o.groundTruth = cl.has("gt") ? cl.get("gt") : "";
 		if (cl.has("mode")) o.modeOverride = cl.get("mode");
 		if (cl.has("camera")) o.cameraOverride = cl.get("camera");
+		if (cl.has("set"))
+		{
+			o.set = cl.get("set");
+			try
+			{
+				parseOverrides(o.set, "--set");  // syntax errors are command-line errors
+			}
+			catch (const std::invalid_argument& e)
+			{
+				throw core::CommandLineError(e.what());
+			}
+		}
 		if (cl.has("max-frames"))
 		{
 			const long n = cl.getInt("max-frames");

@@ -8,6 +8,8 @@
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/slam/LiveFrameSource.h>
 
+#include <mrpt/config/CConfigFileBase.h>
+
 #include <functional>
 #include <memory>
 #include <string>
@@ -39,9 +41,11 @@ LiveLoopResult runLiveLoop(
 	System& sys, LiveFrameSource& source, const LiveLoopOptions& opts,
 	const std::function<void(const sfm::TrackedFrame&)>& onFrame);
 
-/** Opens the OpenNI2 camera configured in the [live] section of `iniPath` (COpenNI2Sensor keys
+/** Opens the OpenNI2 camera configured in the [live] section of `ini` (COpenNI2Sensor keys
  * plus OpenNI2SourceOptions; [slam] camera other than auto overrides the intrinsics), wrapped
- * in a LiveFrameSource that stops waiting when interruptRequested(). */
-std::unique_ptr<LiveFrameSource> openLiveCamera(const std::string& iniPath, const SlamConfig& cfg);
+ * in a LiveFrameSource that stops waiting when interruptRequested(). `origin` (the file) starts
+ * error messages. */
+std::unique_ptr<LiveFrameSource> openLiveCamera(
+	const mrpt::config::CConfigFileBase& ini, const std::string& origin, const SlamConfig& cfg);
 
 }  // namespace keygrid::slam

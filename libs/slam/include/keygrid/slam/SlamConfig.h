@@ -55,7 +55,9 @@ struct SlamConfig
 	/** Throws std::invalid_argument naming the first key of a SlamConfig section ([slam],
 	 * [tracker], [hoc], ...) that no option reads. */
 	static void checkKnownKeys(const mrpt::config::CConfigFileBase& cfg);
-	/** Loads, validates and checks for unknown keys. */
+	/** Loads, validates and checks for unknown keys; errors start with `origin` (the file). */
+	static SlamConfig FromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& origin);
+	/** FromConfig() of an INI file; throws std::invalid_argument when it does not exist. */
 	static SlamConfig FromFile(const std::string& path);
 };
 

@@ -14,6 +14,9 @@ struct SlamRunOptions
 {
 	std::string configPath, input, output, groundTruth;
 	std::optional<std::string> modeOverride, cameraOverride;
+	/** `section.key=value; ...` applied to an in-memory copy of the configuration file
+	 * (keygrid-slam --set); every key must exist in the file or in keygrid-slam's options. */
+	std::string set;
 	std::size_t maxFrames{0};  //!< 0 = all
 	bool quiet{false};
 	/** Grab from the OpenNI2 camera of the config's [live] section instead of `input` */
