@@ -95,7 +95,7 @@ TEST(ShippedScenes, LoadAndMoveWithinTrackableSpeeds)
 {
 	const std::string dir = test::sourceDir() + "/config/sim";
 	const char* names[] = {
-		"room_loop", "corridor_loop", "static_camera_dynamic", "moving_camera_dynamic",
+		"room_loop", "corridor_loop", "static_camera_dynamic", "static_camera_crowd", "moving_camera_dynamic",
 		"relocalization", "room_survey"};
 	for (const char* n : names)
 	{

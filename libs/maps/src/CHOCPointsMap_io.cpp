@@ -71,6 +71,7 @@ void CHOCPointsMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t ver
 	in >> sub >> o.sigmoidGain >> o.sigmoidOffset >> o.selectThreshold >> o.pruneThreshold >> lim >> init >> o.occlusionToleranceAbs >>
 		o.occlusionToleranceRel >> o.visibleDepthMin >> o.visibleDepthMax;
 	if (version >= 1) in >> o.decrementNeedsKeypoint;
+	else o.decrementNeedsKeypoint = false;  // the default changed to true after version 0
 	o.subdivisions = sub;
 	o.countLimit = lim;
 	o.initialCount = init;

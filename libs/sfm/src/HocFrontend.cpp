@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <set>
+#include <unordered_map>
 
 namespace keygrid::sfm
 {
@@ -17,19 +18,54 @@ HocFrontend::HocFrontend(const maps::HocOptions& opts) : m_opts(opts), m_geom(op
 void HocFrontend::seed(Landmark& lm, const SparseMap& map) const
 {
 	if (lm.hoc.touched()) return;
-	for (const auto& [kf, kp] : lm.observations)
+	// Only the creating keyframe observed the point at frame time. Observations that local
+	// mapping adds later in older keyframes (fusion, triangulation) are associations made in
+	// hindsight: a walker that passes the same spot twice is "fused" into the keyframe of its
+	// first pass. Counting them would let unconfirmed points pass the selection.
+	const KeyFrameId kf = lm.firstKeyFrame;
+	if (!map.hasKeyFrame(kf)) return;  // culled before first use: n = 0, unconfirmed
+	const int b = m_geom.bin(lm.p_world, map.keyframe(kf).cameraCenter());
+	if (b >= 0) lm.hoc.add(b, m_opts.initialCount, m_opts.countLimit, m_geom.numBins());
+}
+
+void HocFrontend::confirmInitialMap(SparseMap& map, KeyFrameId kf) const
+{
+	if (!map.hasKeyFrame(kf)) return;
+	const Eigen::Vector3d c = map.keyframe(kf).cameraCenter();
+	for (LandmarkId id : map.keyframe(kf).landmarks)
 	{
-		if (!map.hasKeyFrame(kf)) continue;
-		const int b = m_geom.bin(lm.p_world, map.keyframe(kf).cameraCenter());
-		if (b >= 0) lm.hoc.add(b, m_opts.initialCount, m_opts.countLimit, m_geom.numBins());
+		if (id == kNoLandmark || !map.hasLandmark(id)) continue;
+		auto& lm = map.landmark(id);
+		seed(lm, map);
+		const int b = m_geom.bin(lm.p_world, c);
+		if (b >= 0) lm.hoc.add(b, 1, m_opts.countLimit, m_geom.numBins());
 	}
 }
 
-bool HocFrontend::usable(Landmark& lm, const SparseMap& map, const Eigen::Vector3d& c) const
+bool HocFrontend::usable(Landmark& lm, const SparseMap& map, const Eigen::Vector3d& c, bool fallback) const
 {
 	seed(lm, map);
 	const int b = m_geom.bin(lm.p_world, c);
-	return b < 0 || m_opts.weight(lm.hoc.count(b)) > m_opts.selectThreshold;
+	const double threshold = fallback ? std::min(m_opts.selectThreshold, m_opts.weight(0)) : m_opts.selectThreshold;
+	return b < 0 || m_opts.weight(lm.hoc.count(b)) > threshold;
+}
+
+bool HocFrontend::fitsPose(const FrameFeatures& f, int kp, const ProjectedLandmark& p) const
+{
+	// The pose refinement's inlier test (PoseOptimizer.h): squared reprojection error in units
+	// of the keypoint's level scale, plus the virtual-disparity residual bf/z when both depths
+	// are known, against the 95 % chi-square bound (2 or 3 DOF). The search window alone lets
+	// a walker's point count as seen: it accepts up to radius * scale pixels of motion.
+	const double s = f.levelScale[f.keypoints[kp].octave];
+	const double du = (f.undistorted[kp].x - p.u) / s, dv = (f.undistorted[kp].y - p.v) / s;
+	double e2 = du * du + dv * dv;
+	const bool rgbd = f.depth[kp] > 0 && p.depth > 0 && f.depth[kp] < m_gate.maxDepthForRgbd;
+	if (rgbd)
+	{
+		const double dr = (m_gate.bf / f.depth[kp] - m_gate.bf / p.depth) / m_gate.disparitySigma;
+		e2 += dr * dr;
+	}
+	return e2 <= (rgbd ? m_gate.chi2Rgbd : m_gate.chi2Mono);
 }
 
 bool HocFrontend::hasDepth(const cv::Mat& depth, float u, float v)
@@ -51,6 +87,24 @@ bool HocFrontend::occluded(const cv::Mat& depth, float u, float v, float predict
 	if (!hasDepth(depth, u, v)) return false;
 	const float d = depth.at<float>(static_cast<int>(std::lround(v)), static_cast<int>(std::lround(u)));
 	return d < predicted - (m_opts.occlusionToleranceAbs + m_opts.occlusionToleranceRel * predicted);
+}
+
+bool HocFrontend::seenThrough(const cv::Mat& depth, float u, float v, float predicted) const
+{
+	// A 3 x 3 pattern of samples 3 px apart: a point on a depth edge, whose projection lands
+	// on the far side after a pixel of pose or depth error, has near samples too; a point
+	// whose whole surroundings read farther away is gone. Holes count as "not seen through"
+	// (Kinect holes cluster at edges and on dark or shiny surfaces).
+	constexpr int kStep = 3;
+	const float tol = static_cast<float>(m_opts.occlusionToleranceAbs + m_opts.occlusionToleranceRel * predicted);
+	for (int dy = -kStep; dy <= kStep; dy += kStep)
+		for (int dx = -kStep; dx <= kStep; dx += kStep)
+		{
+			if (!hasDepth(depth, u + dx, v + dy)) return false;
+			const float d = depth.at<float>(static_cast<int>(std::lround(v + dy)), static_cast<int>(std::lround(u + dx)));
+			if (!(d > predicted + tol)) return false;
+		}
+	return true;
 }
 
 HocUpdateStats HocFrontend::update(
@@ -76,8 +130,11 @@ HocUpdateStats HocFrontend::update(
 	std::vector<LandmarkId> again(matched);
 	searchByProjection(f, excluded, searchRadius, matcherOpts, again);
 	std::set<LandmarkId> recovered;
+	std::unordered_map<LandmarkId, const ProjectedLandmark*> proj;
+	for (const auto& p : excluded) proj[p.id] = &p;
 	for (std::size_t i = 0; i < again.size(); i++)
-		if (again[i] != kNoLandmark && again[i] != matched[i]) recovered.insert(again[i]);
+		if (again[i] != kNoLandmark && again[i] != matched[i] && fitsPose(f, static_cast<int>(i), *proj.at(again[i])))
+			recovered.insert(again[i]);
 
 	std::vector<LandmarkId> decremented;
 	auto miss = [&](const ProjectedLandmark& p) {
@@ -104,8 +161,10 @@ HocUpdateStats HocFrontend::update(
 		// frame, i.e. down when q < 1/2, although nothing changed. A miss with no keypoint in
 		// the window is about as likely for a present point as for a vanished one (likelihood
 		// ratio ~1: no evidence), so it is not counted; a miss with keypoints there that none
-		// matched is counted.
-		if (m_opts.decrementNeedsKeypoint && !keypointInWindow(f, p, searchRadius))
+		// matched is counted. So is a miss where the depth image reads a surface behind the point
+		// all around its projection (seenThrough): the point moved or vanished, and a textureless
+		// background would otherwise never let it be pruned.
+		if (m_opts.decrementNeedsKeypoint && !keypointInWindow(f, p, searchRadius) && !seenThrough(depth, p.u, p.v, p.depth))
 		{
 			st.undetected++;
 			return;

@@ -27,14 +27,18 @@ PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& c) { return {c.fx, c.fy, 
 
 Tracker::Tracker(SparseMap& map, const TrackerOptions& opts) : m_map(map), m_opts(opts)
 {
-	if (opts.hoc.enabled) m_hoc.emplace(opts.hoc);
+	if (opts.hoc.enabled)
+	{
+		m_hoc.emplace(opts.hoc);
+		m_hoc->setResidualGate(opts.pose);
+	}
 }
 
 bool Tracker::hocUsable(LandmarkId id, const Current& cur)
 {
 	// Untimed: callers time whole selection passes. A thread-CPU clock read costs ~1 us here,
 	// more than the selection of one landmark, so timing each call inflated the HOC cost.
-	return !m_hoc || m_hoc->usable(m_map.landmark(id), m_map, translationOf(cur.T_world_cam));
+	return !m_hoc || m_hoc->usable(m_map.landmark(id), m_map, translationOf(cur.T_world_cam), m_hocRelaxed);
 }
 
 TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
@@ -58,50 +62,25 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		return out;
 	}
 
-	bool ok = false;
-	if (m_state == TrackingState::Ok)
+	bool ok = attempt(cur, out);
+	// HOC: a strict selection (select_threshold above p(0)) leaves only confirmed points; after
+	// fast motion into new ground, or once lost, those may be too few while the points of the
+	// newest keyframes still wait for their confirming match. Retry with every point whose
+	// evidence is not negative in the camera's bin (p(n) > p(0)): tracking must not stop on
+	// the selection. Visible/found counters of the failed attempt stay counted.
+	if (!ok && m_hoc && m_hoc->hasFallback())
 	{
-		cur.T_world_cam = m_velocity ? m_lastPose + *m_velocity : m_lastPose;
-		// Without a motion prior (right after initialisation or relocalization) the camera may
-		// have moved tens of pixels: match descriptors against the reference keyframe first.
-		if (!m_velocity)
-		{
-			ok = trackByPnp(cur, m_refKf, m_opts.minInliers / 2);
-			out.method = "pnp";
-		}
-		if (!ok)
-		{
-			cur.matches.assign(cur.features.size(), kNoLandmark);
-			cur.T_world_cam = m_velocity ? m_lastPose + *m_velocity : m_lastPose;
-			ok = trackByPrediction(cur);
-			out.method = "prediction";
-		}
-		if (!ok)
-		{
-			cur.matches.assign(cur.features.size(), kNoLandmark);
-			cur.T_world_cam = m_lastPose;
-			ok = trackByPnp(cur, m_refKf, m_opts.minInliers / 2);
-			out.method = "pnp";
-		}
-	}
-	else
-	{
-		ok = relocalize(cur);
-		out.method = "relocalization";
-	}
-	if (ok)
-	{
-		updateLocalKeyFrames(cur);
-		cur.inliers = trackLocalMap(cur, m_opts.radiusLocalMap);
-		ok = cur.inliers >= m_opts.minInliers;
-		// A look-alike place matches a few dozen landmarks of a local map that shows hundreds
-		// in view; the true place matches a good share of them.
-		if (ok && out.method == "relocalization")
-		{
-			ok = cur.inliers >= m_opts.relocalizationMinInlierRatio * cur.localMapInView;
-			out.relocalizationKeyFrame = m_refKf;
-			out.relocalizedByPlaceRecognition = m_relocRecognized;
-		}
+		const auto method = out.method;
+		cur.matches.assign(cur.features.size(), kNoLandmark);
+		cur.inliers = cur.localMapInView = 0;
+		cur.hocVisible.clear();
+		cur.hocExcluded.clear();
+		cur.matchedBeforeLocalMap.clear();
+		m_hocRelaxed = true;
+		ok = attempt(cur, out);
+		m_hocRelaxed = false;
+		out.hocFallback = ok;
+		if (!ok) out.method = method;
 	}
 
 	out.matches = static_cast<int>(std::count_if(cur.matches.begin(), cur.matches.end(), [](LandmarkId l) { return l != kNoLandmark; }));
@@ -154,6 +133,57 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 	return out;
 }
 
+bool Tracker::attempt(Current& cur, TrackedFrame& out)
+{
+	bool ok = false;
+	if (m_state == TrackingState::Ok)
+	{
+		cur.T_world_cam = m_velocity ? m_lastPose + *m_velocity : m_lastPose;
+		// Without a motion prior (right after initialisation or relocalization) the camera may
+		// have moved tens of pixels: match descriptors against the reference keyframe first.
+		if (!m_velocity)
+		{
+			ok = trackByPnp(cur, m_refKf, m_opts.minInliers / 2);
+			out.method = "pnp";
+		}
+		if (!ok)
+		{
+			cur.matches.assign(cur.features.size(), kNoLandmark);
+			cur.T_world_cam = m_velocity ? m_lastPose + *m_velocity : m_lastPose;
+			ok = trackByPrediction(cur);
+			out.method = "prediction";
+		}
+		if (!ok)
+		{
+			cur.matches.assign(cur.features.size(), kNoLandmark);
+			cur.T_world_cam = m_lastPose;
+			ok = trackByPnp(cur, m_refKf, m_opts.minInliers / 2);
+			out.method = "pnp";
+		}
+	}
+	else
+	{
+		ok = relocalize(cur);
+		out.method = "relocalization";
+	}
+	if (ok)
+	{
+		updateLocalKeyFrames(cur);
+		cur.inliers = trackLocalMap(cur, m_opts.radiusLocalMap);
+		ok = cur.inliers >= m_opts.minInliers;
+		// A look-alike place matches a few dozen landmarks of a local map that shows hundreds
+		// in view; the true place matches a good share of them.
+		if (ok && out.method == "relocalization")
+		{
+			ok = cur.inliers >= m_opts.relocalizationMinInlierRatio * cur.localMapInView;
+			out.relocalizationKeyFrame = m_refKf;
+			out.relocalizedByPlaceRecognition = m_relocRecognized;
+		}
+	}
+
+	return ok;
+}
+
 void Tracker::onMapCorrected()
 {
 	mrpt::poses::CPose3D T_world_ref;
@@ -177,6 +207,7 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	for (std::size_t i = 0; i < f.size(); i++)
 		if (f.depth[i] > 0)
 			m_map.addLandmark(backProject(m_K, f.undistorted[i].x, f.undistorted[i].y, f.depth[i]), id, static_cast<int>(i));
+	if (m_hoc) m_hoc->confirmInitialMap(m_map, id);
 	m_refKf = id;
 	m_lastKfFrame = cur.frame->index;
 	m_localKfs = {id};

@@ -11,7 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 out, png = sys.argv[1], sys.argv[2]
-scenes = [s for s in ("static_camera_dynamic", "moving_camera_dynamic", "relocalization", "room_loop", "fr1_rpy", "augment")
+scenes = [s for s in ("static_camera_dynamic", "static_camera_crowd", "moving_camera_dynamic", "relocalization", "room_loop", "fr1_rpy", "augment")
           if os.path.exists(os.path.join(out, s + "_std", "frames.csv"))]
 cols = min(3, len(scenes))
 rows_n = (len(scenes) + cols - 1) // cols

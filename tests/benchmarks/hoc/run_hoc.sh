@@ -58,7 +58,7 @@ PY
 
 share() { "$BIN/keygrid_dynamic_feature_share" "$1" | sed -E 's/.*share ([0-9.]+ %).*/\1/'; }
 
-for scene in static_camera_dynamic moving_camera_dynamic relocalization; do
+for scene in static_camera_dynamic static_camera_crowd moving_camera_dynamic relocalization; do
 	echo "== $scene" >&2
 	generate "$scene"
 	run "$scene" "$OUT/seq_$scene/tum" "$OUT/seq_$scene/groundtruth.txt" sim

@@ -32,16 +32,18 @@ struct HocOptions : public mrpt::config::CLoadableOptions
 	int subdivisions{0};
 	/** Sigmoid gain and offset of the bin weight p(n) (Default: 1, 0) */
 	double sigmoidGain{1.0}, sigmoidOffset{0.0};
-	/** A point is used for matching from bin b while p(n_b) > this (Default: 0.1, i.e. with
-	 * gain 1 and offset 0: n >= -2) */
-	double selectThreshold{0.1};
+	/** A point is used for matching from bin b while p(n_b) > this (Default: 0.8, i.e. with
+	 * gain 1 and offset 0: n >= 2, so a new point (initial_count 1) takes part in pose
+	 * estimation only after one match at a final pose has confirmed it; the tracker still
+	 * searches for excluded points there, see keygrid::sfm::HocFrontend) */
+	double selectThreshold{0.8};
 	/** A point is removed when its largest bin weight is below this. Bins never updated have
 	 * n = 0, so the threshold must exceed p(0) for pruning to act (Default: 0.6, i.e. no bin
 	 * with n >= 1 left) */
 	double pruneThreshold{0.6};
 	/** |n| limit (Default: 20) */
 	int countLimit{20};
-	/** n given to a new point in the bin of each keyframe that observes it: how many net misses
+	/** n given to a new point in the bin of the keyframe that created it: how many net misses
 	 * it survives before it has to be seen again (Default: 1) */
 	int initialCount{1};
 	/** Occlusion test: the point counts as hidden when the depth image measures a surface
@@ -57,8 +59,8 @@ struct HocOptions : public mrpt::config::CLoadableOptions
 	 * misses makes n drift down by 2q - 1 per frame for a point matched with probability q < 1/2.
 	 * true keeps static maps accurate but prunes less (larger maps); see doc/hoc.md. Used by
 	 * the tracker (keygrid::sfm::HocFrontend); CHOCPointsMap's depth-scan insertion has no
-	 * keypoints and ignores it (Default: false) */
-	bool decrementNeedsKeypoint{false};
+	 * keypoints and ignores it (Default: true) */
+	bool decrementNeedsKeypoint{true};
 
 	/** Bin weight p(n). */
 	double weight(int n) const;

@@ -19,6 +19,7 @@
 #include <keygrid/maps/HocGeometry.h>
 #include <keygrid/maps/HocHistogram.h>
 #include <keygrid/sfm/Matcher.h>
+#include <keygrid/sfm/PoseOptimizer.h>
 #include <keygrid/sfm/SparseMap.h>
 
 #include <vector>
@@ -42,33 +43,58 @@ class HocFrontend
 	const maps::HocOptions& options() const { return m_opts; }
 	const maps::HocGeometry& geometry() const { return m_geom; }
 
-	/** Whether lm may be used from a camera centred at c (seeds an untouched histogram). */
-	bool usable(Landmark& lm, const SparseMap& map, const Eigen::Vector3d& c) const;
+	/** Whether lm may be used from a camera centred at c (seeds an untouched histogram):
+	 * p(n) > select_threshold in c's bin; with `fallback`, p(n) > min(select_threshold, p(0)),
+	 * i.e. no more misses than matches there (the tracker's retry, see Tracker::track). */
+	bool usable(Landmark& lm, const SparseMap& map, const Eigen::Vector3d& c, bool fallback = false) const;
+	/** True when the fallback selection admits more points than the normal one. */
+	bool hasFallback() const { return m_opts.selectThreshold > m_opts.weight(0); }
 
 	/** One frame's update and pruning. `matched`: the final inlier landmark of each keypoint
 	 * (kNoLandmark if none); `visible`: projections of the local-map landmarks that were
 	 * candidates for matching; `excluded`: visible ones the selection kept out; `depth`:
 	 * the frame's depth image [m] (empty: nothing is decremented).
-	 * Excluded landmarks found again by a guided search are counted as recovered (+1). */
+	 * Excluded landmarks found again by a guided search at the final pose are counted as
+	 * recovered (+1) when the match also passes fitsPose(), as the pose's inliers did. */
 	HocUpdateStats update(
 		SparseMap& map, const FrameFeatures& f, const std::vector<LandmarkId>& matched,
 		const std::vector<ProjectedLandmark>& visible, const std::vector<ProjectedLandmark>& excluded,
 		const cv::Mat& depth, const Eigen::Vector3d& cameraCentre, float searchRadius,
 		const MatcherOptions& matcherOpts) const;
 
-	/** Adds +1 at the bin of each observing keyframe when the histogram is untouched. */
+	/** An untouched histogram gets initial_count in the bin of the keyframe that created the
+	 * point (the oldest one observing it if that was culled). Later observations that local
+	 * mapping adds in other keyframes are not counted (see the .cpp). */
 	void seed(Landmark& lm, const SparseMap& map) const;
+	/** +1 in keyframe kf's bin for each of its points: the map-initialization keyframe, whose
+	 * points are all there is to track the next frame with (with select_threshold above
+	 * p(initial_count) a new point otherwise needs one confirming match first). */
+	void confirmInitialMap(SparseMap& map, KeyFrameId kf) const;
+	/** Whether keypoint kp of f fits the projection p at the final pose: the pose refinement's
+	 * chi-square inlier test (reprojection at the keypoint's level, plus the virtual disparity
+	 * when both depths are known; the gate options of setResidualGate()). */
+	bool fitsPose(const FrameFeatures& f, int kp, const ProjectedLandmark& p) const;
 
 	/** True when the depth image shows a surface in front of the predicted depth at (u, v)
 	 * (the point is hidden); false also when there is no valid depth there. */
 	bool occluded(const cv::Mat& depth, float u, float v, float predictedDepth) const;
+	/** True when the depth image reads a surface behind the predicted depth by more than the
+	 * occlusion tolerance at (u, v) and at the 8 samples 3 px around it (all valid): the point's
+	 * place is seen through, it moved or vanished. Such a miss counts even with
+	 * decrement_needs_keypoint. */
+	bool seenThrough(const cv::Mat& depth, float u, float v, float predictedDepth) const;
 	/** True when f has a keypoint in p's search window: within radius * scale(level) of the
 	 * projection at the predicted level +-1, the keypoints searchByProjection compares. */
 	static bool keypointInWindow(const FrameFeatures& f, const ProjectedLandmark& p, float radius);
 	/** True when the depth image has a valid value at (u, v). */
 	static bool hasDepth(const cv::Mat& depth, float u, float v);
 
+	/** Residual model and chi-square bounds of fitsPose() (the tracker passes its pose
+	 * refinement's options; default-constructed until then). */
+	void setResidualGate(const PoseOptimizerOptions& o) { m_gate = o; }
+
    private:
+	PoseOptimizerOptions m_gate;
 	maps::HocOptions m_opts;
 	maps::HocGeometry m_geom;
 };

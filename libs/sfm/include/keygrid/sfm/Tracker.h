@@ -47,6 +47,7 @@ struct TrackedFrame
 	/** HOC bookkeeping of this frame (zero when [hoc] is disabled). */
 	HocUpdateStats hoc;
 	double hocSeconds{0};  //!< thread CPU time of HOC selection and update [s]
+	bool hocFallback{false};  //!< tracked only with the HOC fallback selection (Tracker::track)
 	/** When method is "relocalization" and the frame was tracked: the keyframe it was found
 	 * on, and whether place recognition (rather than the newest keyframes) proposed it. */
 	KeyFrameId relocalizationKeyFrame{0};
@@ -100,6 +101,9 @@ class Tracker
 	};
 
 	bool initialize(Current& cur, TrackedFrame& out);
+	/** One tracking attempt of an initialized tracker: motion model / PnP or relocalization,
+	 * then the local map; fills out.method; true when the pose is good. */
+	bool attempt(Current& cur, TrackedFrame& out);
 	bool trackByPrediction(Current& cur);
 	/** Descriptor matches with keyframe kf's landmarks, PnP-RANSAC, refinement; succeeds with
 	 * at least minRefinedInliers inliers after the refinement. */
@@ -128,6 +132,8 @@ class Tracker
 	mrpt::poses::CPose3D m_lastPose;
 	std::optional<mrpt::poses::CPose3D> m_velocity;  //!< T_last_cur of the last tracked step
 	KeyFrameId m_refKf{0};
+	/** HOC: the current attempt uses the fallback selection (see track()) */
+	bool m_hocRelaxed{false};
 	/** The last frame's reference keyframe and its pose relative to it. */
 	std::optional<std::pair<KeyFrameId, mrpt::poses::CPose3D>> m_lastRelative;
 	std::size_t m_lastKfFrame{0};
