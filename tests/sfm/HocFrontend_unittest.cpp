@@ -135,6 +135,7 @@ TEST(HocFrontend, MissCountsOnlyWithKeypointInSearchWindowWhenRequired)
 		EXPECT_EQ(st.occluded, 0);
 		EXPECT_EQ(st.decremented, needKeypoint ? 1 : 3);
 		EXPECT_EQ(st.undetected, needKeypoint ? 2 : 0);
+		EXPECT_EQ(st.seenThrough, 0);  // the depth image reads every surface where predicted
 		EXPECT_EQ(st.pruned, needKeypoint ? 1 : 3);  // +1 seed - 1 = 0: max weight 0.5 < 0.6
 		EXPECT_FALSE(map.hasLandmark(lm[0]));
 		for (int i : {1, 2})
@@ -286,6 +287,7 @@ TEST(HocFrontend, SeenThroughMissCountsWithoutKeypoint)
 	const auto st = hoc.update(map, f, {kNoLandmark}, visible, {}, depth, c, 4.f, MatcherOptions());
 	EXPECT_EQ(st.decremented, 1);
 	EXPECT_EQ(st.undetected, 1);
+	EXPECT_EQ(st.seenThrough, 1);
 	EXPECT_EQ(st.pruned, 1);  // seed 1 - 1 = 0: weight 0.5 < prune threshold 0.6
 	EXPECT_FALSE(map.hasLandmark(gone));
 	EXPECT_TRUE(map.hasLandmark(there));

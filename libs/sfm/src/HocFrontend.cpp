@@ -164,10 +164,14 @@ HocUpdateStats HocFrontend::update(
 		// matched is counted. So is a miss where the depth image reads a surface behind the point
 		// all around its projection (seenThrough): the point moved or vanished, and a textureless
 		// background would otherwise never let it be pruned.
-		if (m_opts.decrementNeedsKeypoint && !keypointInWindow(f, p, searchRadius) && !seenThrough(depth, p.u, p.v, p.depth))
+		if (m_opts.decrementNeedsKeypoint && !keypointInWindow(f, p, searchRadius))
 		{
-			st.undetected++;
-			return;
+			if (!seenThrough(depth, p.u, p.v, p.depth))
+			{
+				st.undetected++;
+				return;
+			}
+			st.seenThrough++;
 		}
 		bump(lm, -1);
 		decremented.push_back(p.id);

@@ -85,6 +85,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		m_stats.hocDecrements += tf.hoc.decremented;
 		m_stats.hocOccluded += tf.hoc.occluded;
 		m_stats.hocRecovered += tf.hoc.recovered;
+		m_stats.hocSeenThrough += tf.hoc.seenThrough;
 		if (tf.hocFallback) m_stats.hocFallbackFrames++;
 		m_stats.frames++;
 		m_stats.sumInliers += tf.inliers;

@@ -371,7 +371,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (cfg.mode == "threaded") js << "  \"ba_discarded\": " << st.baDiscarded << ",\n";
 	if (cfg.tracker.hoc.enabled)
 		js << "  \"hoc\": {\"landmarks_pruned\": " << st.landmarksPrunedHoc << ", \"increments\": " << st.hocIncrements
-		   << ", \"decrements\": " << st.hocDecrements << ", \"occluded\": " << st.hocOccluded << ", \"recovered\": " << st.hocRecovered << ", \"fallback_frames\": " << st.hocFallbackFrames << "},\n";
+		   << ", \"decrements\": " << st.hocDecrements << ", \"occluded\": " << st.hocOccluded << ", \"recovered\": " << st.hocRecovered << ", \"seen_through\": " << st.hocSeenThrough << ", \"fallback_frames\": " << st.hocFallbackFrames << "},\n";
 	if (sys.loopCloser()) js << "  \"vocabulary\": \"" << jsonEscape(sys.loopCloser()->vocabularySource()) << "\",\n";
 	js << "  \"loop_closures\": [";
 	for (std::size_t i = 0; i < sys.loopClosures().size(); i++)

@@ -33,6 +33,9 @@ struct HocUpdateStats
 	/** Misses not counted because no keypoint was detected in the search window
 	 * (decrement_needs_keypoint). */
 	int undetected{0};
+	/** Of the decrements, those counted only because the place was seen through (no keypoint
+	 * in the window; decrement_needs_keypoint). */
+	int seenThrough{0};
 };
 
 class HocFrontend

@@ -37,10 +37,11 @@ struct SystemStats
 {
 	std::size_t frames{0}, tracked{0}, lost{0}, relocalizations{0}, pnpFallbacks{0};
 	std::size_t keyframesCreated{0}, keyframesCulled{0}, landmarksCulled{0}, landmarksFused{0};
-	/** HOC: landmarks erased by pruning, the bin updates of all frames, and the frames tracked
-	 * only with the fallback selection (sfm::Tracker::track). */
+	/** HOC: landmarks erased by pruning, the bin updates of all frames (hocSeenThrough: the
+	 * decrements counted by the seen-through rule), and the frames tracked only with the
+	 * fallback selection (sfm::Tracker::track). */
 	std::size_t landmarksPrunedHoc{0}, hocIncrements{0}, hocDecrements{0}, hocOccluded{0}, hocRecovered{0};
-	std::size_t hocFallbackFrames{0};
+	std::size_t hocSeenThrough{0}, hocFallbackFrames{0};
 	double sumInliers{0}, sumBaKeyFrames{0}, sumBaObservations{0}, sumBaOutliers{0};
 	/** Threaded mode: local bundle adjustments dropped because a loop closure moved the map
 	 * while they were solved. */
