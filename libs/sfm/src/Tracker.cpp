@@ -91,6 +91,11 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		m_lastPose = cur.T_world_cam;
 		m_state = TrackingState::Ok;
 		m_framesLost = 0;
+		if (out.method != "relocalization" && cur.localMapInView > 0)
+		{
+			m_recentShares.push_back(static_cast<double>(cur.inliers) / cur.localMapInView);
+			if (m_recentShares.size() > kRecentShares) m_recentShares.pop_front();
+		}
 		m_lastInliers.clear();
 		for (std::size_t i = 0; i < cur.matches.size(); i++)
 		{
@@ -175,7 +180,7 @@ bool Tracker::attempt(Current& cur, TrackedFrame& out)
 		// in view; the true place matches a good share of them.
 		if (ok && out.method == "relocalization")
 		{
-			ok = cur.inliers >= m_opts.relocalizationMinInlierRatio * cur.localMapInView;
+			ok = cur.inliers >= requiredRelocalizationShare(m_opts, {m_recentShares.begin(), m_recentShares.end()}) * cur.localMapInView;
 			out.relocalizationKeyFrame = m_refKf;
 			out.relocalizedByPlaceRecognition = m_relocRecognized;
 		}

@@ -1,6 +1,7 @@
 #include <keygrid/sfm/TrackerOptions.h>
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace keygrid::sfm
@@ -25,6 +26,7 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	relocalizationCandidates = c.read_int(s, "relocalization_candidates", relocalizationCandidates);
 	relocalizationBowCandidates = c.read_int(s, "relocalization_bow_candidates", relocalizationBowCandidates);
 	relocalizationMinInlierRatio = c.read_double(s, "relocalization_min_inlier_ratio", relocalizationMinInlierRatio);
+	relocalizationShareFactor = c.read_double(s, "relocalization_share_factor", relocalizationShareFactor);
 	maxFramesBetweenKeyFrames = c.read_int(s, "max_frames_between_keyframes", maxFramesBetweenKeyFrames);
 	keyFrameTrackedRatio = c.read_double(s, "keyframe_tracked_ratio", keyFrameTrackedRatio);
 	keyFrameRefMinObservations = c.read_int(s, "keyframe_ref_min_observations", keyFrameRefMinObservations);
@@ -56,6 +58,8 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 		throw std::invalid_argument("[" + s + "] relocalization_candidates / relocalization_bow_candidates must be >= 0");
 	if (!(relocalizationMinInlierRatio >= 0 && relocalizationMinInlierRatio <= 1))
 		throw std::invalid_argument("[" + s + "] relocalization_min_inlier_ratio = " + std::to_string(relocalizationMinInlierRatio) + " (must be in [0, 1])");
+	if (!(relocalizationShareFactor >= 0 && relocalizationShareFactor <= 1))
+		throw std::invalid_argument("[" + s + "] relocalization_share_factor = " + std::to_string(relocalizationShareFactor) + " (must be in [0, 1])");
 	if (!(keyFrameTrackedRatio > 0 && keyFrameTrackedRatio <= 1))
 		throw std::invalid_argument("[" + s + "] keyframe_tracked_ratio = " + std::to_string(keyFrameTrackedRatio) + " (must be in (0, 1])");
 	if (!(matcher.ratio > 0 && matcher.ratio <= 1))
@@ -73,6 +77,7 @@ void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "relocalization_candidates", relocalizationCandidates, 34, 40, "newest keyframes tried when lost");
 	c.write(s, "relocalization_bow_candidates", relocalizationBowCandidates, 34, 40, "vocabulary-tree candidates tried first when lost");
 	c.write(s, "relocalization_min_inlier_ratio", relocalizationMinInlierRatio, 34, 40, "share of the local map in view a relocalization must match");
+	c.write(s, "relocalization_share_factor", relocalizationShareFactor, 34, 40, "or less: this x median share of recent tracked frames; 0 = fixed");
 	c.write(s, "max_frames_between_keyframes", maxFramesBetweenKeyFrames, 34, 40, "");
 	c.write(s, "keyframe_tracked_ratio", keyFrameTrackedRatio, 34, 40, "new keyframe below this share of the reference's landmarks");
 	c.write(s, "keyframe_ref_min_observations", keyFrameRefMinObservations, 34, 40, "reference landmarks counted: seen by >= this many keyframes");
@@ -89,6 +94,14 @@ void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "pose_rounds", pose.rounds, 34, 40, "outlier rounds of pose refinement");
 	c.write(s, "pose_iterations", pose.iterationsPerRound, 34, 40, "iterations per round");
 	c.write(s, "seed", pnp.seed, 34, 40, "RANSAC seed");
+}
+
+double requiredRelocalizationShare(const TrackerOptions& o, std::vector<double> recent)
+{
+	if (o.relocalizationShareFactor <= 0 || recent.empty()) return o.relocalizationMinInlierRatio;
+	auto mid = recent.begin() + static_cast<std::ptrdiff_t>(recent.size() / 2);
+	std::nth_element(recent.begin(), mid, recent.end());
+	return std::min(o.relocalizationMinInlierRatio, o.relocalizationShareFactor * *mid);
 }
 
 }  // namespace keygrid::sfm

@@ -10,6 +10,7 @@
 #include <keygrid/sfm/SparseMap.h>
 #include <keygrid/sfm/TrackerOptions.h>
 
+#include <deque>
 #include <functional>
 #include <optional>
 #include <string>
@@ -134,6 +135,10 @@ class Tracker
 	KeyFrameId m_refKf{0};
 	/** HOC: the current attempt uses the fallback selection (see track()) */
 	bool m_hocRelaxed{false};
+	/** Share of the local map in view matched by the last kRecentShares tracked frames (not
+	 * relocalizations): the yardstick of requiredRelocalizationShare(). */
+	static constexpr std::size_t kRecentShares = 30;
+	std::deque<double> m_recentShares;
 	/** The last frame's reference keyframe and its pose relative to it. */
 	std::optional<std::pair<KeyFrameId, mrpt::poses::CPose3D>> m_lastRelative;
 	std::size_t m_lastKfFrame{0};
