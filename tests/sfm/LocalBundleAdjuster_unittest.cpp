@@ -197,6 +197,36 @@ TEST(LocalBundleAdjuster, RecoversTheSceneWithEverySolverAndJacobian)
 	for (const auto& r : results) EXPECT_LT((r - results.front()).translation().norm(), 1e-6);
 }
 
+TEST(LocalBundleAdjuster, FunctionToleranceEndsTheSolveOnceAnIterationGainsLittle)
+{
+	// Noisy measurements (1 px): the cost has a floor well above zero. With tolerance 0 the
+	// solve runs until the parameters stop moving (Ceres' parameter tolerance; 7 iterations
+	// here); with 0.5 it stops at the first iteration that lowers the cost by less than half,
+	// short of the floor; the default 1e-3 stops earlier than the full solve yet within 1 % of
+	// its cost.
+	auto solve = [](double tol)
+	{
+		Scene s;
+		buildScene(s, 0.02, 0.05);
+		std::mt19937 rng(3);
+		std::normal_distribution<double> N(0.0, 1.0);
+		for (KeyFrameId k = 0; k < 4; k++)
+			for (auto& uv : s.map.keyframe(k).features.undistorted) uv += cv::Point2f(static_cast<float>(N(rng)), static_cast<float>(N(rng)));
+		BundleAdjusterOptions o;
+		o.iterations = 25;
+		o.functionTolerance = tol;
+		o.chi2Mono = o.chi2Rgbd = 1e9;  // keep every observation: the costs compare like for like
+		return localBundleAdjustment(s.map, 3, K, o);
+	};
+	const auto full = solve(0.0), loose = solve(0.5), dflt = solve(1e-3);
+	EXPECT_LT(loose.iterations, full.iterations);
+	EXPECT_GE(loose.iterations, 1);
+	EXPECT_GT(loose.finalCost, 1.05 * full.finalCost);
+	EXPECT_LT(dflt.iterations, full.iterations);
+	EXPECT_LT(dflt.finalCost, 1.01 * full.finalCost);
+	EXPECT_LT(full.finalCost, 0.5 * full.initialCost);
+}
+
 TEST(LocalBundleAdjuster, RemovesAGrossOutlierObservation)
 {
 	Scene s;
@@ -262,6 +292,7 @@ TEST(LocalBundleAdjuster, OptionsRoundTripAndRejectUnknownSolver)
 	BundleAdjusterOptions o;
 	o.linearSolver = BaLinearSolver::IterativeSchur;
 	o.analyticJacobians = false;
+	o.functionTolerance = 0.02;
 	o.saveToConfigFile(saved, "mapping");
 	// Read back from the text, as a file would be.
 	std::string text;
@@ -271,6 +302,12 @@ TEST(LocalBundleAdjuster, OptionsRoundTripAndRejectUnknownSolver)
 	back.loadFromConfigFile(cfg, "mapping");
 	EXPECT_EQ(back.linearSolver, BaLinearSolver::IterativeSchur);
 	EXPECT_FALSE(back.analyticJacobians);
+	EXPECT_DOUBLE_EQ(back.functionTolerance, 0.02);
+	for (const char* bad : {"1", "-0.1"})
+	{
+		cfg = mrpt::config::CConfigFileMemory(std::string("[mapping]\nfunction_tolerance = ") + bad + "\n");
+		EXPECT_THROW(back.loadFromConfigFile(cfg, "mapping"), std::invalid_argument) << bad;
+	}
 	cfg = mrpt::config::CConfigFileMemory("[mapping]\nlinear_solver = cholmod\n");
 	try
 	{

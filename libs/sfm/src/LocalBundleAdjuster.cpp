@@ -44,6 +44,7 @@ void BundleAdjusterOptions::loadFromConfigFile(const mrpt::config::CConfigFileBa
 	windowSize = c.read_int(s, "window_size", windowSize);
 	maxFixedKeyFrames = c.read_int(s, "max_fixed_keyframes", maxFixedKeyFrames);
 	iterations = c.read_int(s, "iterations", iterations);
+	functionTolerance = c.read_double(s, "function_tolerance", functionTolerance);
 	threads = c.read_int(s, "threads", threads);
 	analyticJacobians = c.read_bool(s, "analytic_jacobians", analyticJacobians);
 	const std::string solver = c.read_string(s, "linear_solver", solverName(linearSolver));
@@ -58,6 +59,8 @@ void BundleAdjusterOptions::loadFromConfigFile(const mrpt::config::CConfigFileBa
 		throw std::invalid_argument("[" + s + "] linear_solver = " + solver + " (must be auto, dense_schur, sparse_schur or iterative_schur)");
 	if (windowSize < 1) throw std::invalid_argument("[" + s + "] window_size = " + std::to_string(windowSize) + " (must be >= 1)");
 	if (iterations < 1) throw std::invalid_argument("[" + s + "] iterations = " + std::to_string(iterations) + " (must be >= 1)");
+	if (!(functionTolerance >= 0 && functionTolerance < 1))
+		throw std::invalid_argument("[" + s + "] function_tolerance = " + std::to_string(functionTolerance) + " (must be in [0, 1))");
 	if (threads < 1) throw std::invalid_argument("[" + s + "] threads = " + std::to_string(threads) + " (must be >= 1)");
 }
 
@@ -65,7 +68,8 @@ void BundleAdjusterOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, c
 {
 	c.write(s, "window_size", windowSize, 30, 40, "covisible keyframes optimised with the new one");
 	c.write(s, "max_fixed_keyframes", maxFixedKeyFrames, 30, 40, "fixed keyframes anchoring the window");
-	c.write(s, "iterations", iterations, 30, 40, "Levenberg-Marquardt iterations");
+	c.write(s, "iterations", iterations, 30, 40, "Levenberg-Marquardt iterations at most");
+	c.write(s, "function_tolerance", functionTolerance, 30, 40, "stop once an iteration lowers the cost by less than this fraction");
 	c.write(s, "threads", threads, 30, 40, "Ceres threads (1 = deterministic)");
 	c.write(s, "analytic_jacobians", analyticJacobians, 30, 40, "hand-written Jacobians (false: Ceres autodiff)");
 	c.write(s, "linear_solver", std::string(solverName(linearSolver)), 30, 40, "auto | dense_schur | sparse_schur | iterative_schur");
@@ -276,12 +280,14 @@ void BundleAdjustment::solve()
 	so.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
 	so.linear_solver_ordering = m->ordering;
 	so.max_num_iterations = o.iterations;
+	so.function_tolerance = o.functionTolerance;
 	so.num_threads = o.threads;
 	so.logging_type = ceres::SILENT;
 	ceres::Solver::Summary summary;
 	ceres::Solve(so, &m->problem, &summary);
 	m->report.initialCost = summary.initial_cost;
 	m->report.finalCost = summary.final_cost;
+	m->report.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
 }
 
 BundleAdjusterReport BundleAdjustment::apply(SparseMap& map)

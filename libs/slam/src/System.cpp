@@ -120,6 +120,7 @@ void System::mapKeyFrame(const KeyFrameJob& job, std::unique_lock<std::mutex>* m
 	m_stats.sumBaKeyFrames += rep.ba.keyframes;
 	m_stats.sumBaObservations += rep.ba.observations;
 	m_stats.sumBaOutliers += rep.ba.outliersRemoved;
+	m_stats.sumBaIterations += rep.ba.iterations;
 	m_stats.baDiscarded += rep.baDiscarded ? 1 : 0;
 }
 
@@ -271,6 +272,8 @@ void System::finish()
 	{
 		auto o = m_cfg.mapping.ba;
 		o.iterations = m_cfg.refinement.globalIterations;
+		// Once per run: to convergence (Ceres' default tolerance), not the local windows' early stop.
+		o.functionTolerance = 1e-6;
 		sfm::globalBundleAdjustment(m_map, *m_K, o);
 	}
 	m_timings.add("global_bundle_adjustment", secondsSince(t0));

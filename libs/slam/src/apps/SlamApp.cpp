@@ -18,6 +18,7 @@
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/vector_loadsave.h>
 #include <mrpt/system/filesystem.h>
+#include <opencv2/core/utility.hpp>
 
 #include <chrono>
 #include <csignal>
@@ -70,6 +71,22 @@ std::string effectiveConfigText(const std::string& path, const std::string& set)
 	return applyOverrides(text, overrides);
 }
 
+/** OpenCV's own worker threads off for the lifetime of a run, restored afterwards. The run
+ * already keeps both cores busy with its pipeline (decoding, extraction, tracking and mapping
+ * on their own threads); OpenCV parallelising the extraction on top of that preempts tracking
+ * (fr1_rpy, 2026-11-25: 28.0-29.9 -> 32.5-34.1 fps sequential, doc/frontend.md "Modes"). */
+class OpenCvThreadsOff
+{
+   public:
+	OpenCvThreadsOff() : m_previous(cv::getNumThreads()) { cv::setNumThreads(1); }
+	~OpenCvThreadsOff() { cv::setNumThreads(m_previous); }
+	OpenCvThreadsOff(const OpenCvThreadsOff&) = delete;
+	OpenCvThreadsOff& operator=(const OpenCvThreadsOff&) = delete;
+
+   private:
+	int m_previous;
+};
+
 struct Extracted
 {
 	core::Frame frame;
@@ -93,6 +110,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		if (ec || !mrpt::system::directoryExists(o.output))
 			throw std::runtime_error("cannot create output folder '" + o.output + "'" + (ec ? ": " + ec.message() : std::string()));
 	}
+	const OpenCvThreadsOff openCvThreadsOff;
 	core::FrameSourceOptions so;
 	if (!cfg.camera.empty() && cfg.camera != "auto") so.camera = core::RgbdCamera::FromPresetOrFile(cfg.camera);
 	// Files: decoding runs ahead on its own thread in both modes; frames keep their order.
@@ -138,24 +156,12 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			res.liveGrabbed = lr.grabbed;
 			res.liveDropped = lr.dropped;
 		}
-		else if (cfg.mode == "sequential")
-		{
-			core::Frame f;
-			for (std::size_t n = 0; !limitReached(n) && !interruptRequested(); n++)
-			{
-				auto t0 = Clock::now();
-				if (!source->next(f)) break;
-				sys.timings().add("load_wait", since(t0));
-				sys.timings().add("load", source->lastLoadSeconds());
-				t0 = Clock::now();
-				report(sys.process(f));
-				sys.timings().add("frame_total", since(t0));
-			}
-		}
 		else
 		{
-			// Threaded: decoding (prefetch thread) -> feature extraction (producer thread) ->
-			// tracking and mapping in order on this thread, joined by typed bounded queues.
+			// Decoding (prefetch thread) -> feature extraction (producer thread) -> tracking, then
+			// (sequential mode) local mapping and loop closing in order on this thread, joined by
+			// typed bounded queues. Decoding and extraction are functions of the frame alone, so
+			// running them ahead keeps sequential mode deterministic.
 			core::BoundedQueue<Extracted> queue(4);
 			std::string producerError;
 			std::thread producer([&] {
@@ -180,8 +186,12 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			});
 			try
 			{
-				while (auto e = queue.pop())
+				for (;;)
 				{
+					const auto tWait = Clock::now();
+					auto e = queue.pop();
+					if (!e) break;
+					sys.timings().add("input_wait", since(tWait));
 					sys.timings().add("load", e->loadSeconds);
 					sys.timings().add("extract", e->extractSeconds);
 					const auto t0 = Clock::now();
@@ -388,10 +398,11 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	js << "],\n";
 	js << "  \"maps\": " << (sys.metricMaps() ? sys.metricMaps()->summaryJson() : std::string("[]")) << ",\n";
 	{
-		char m[256];
+		char m[320];
 		const double kfs = std::max<std::size_t>(1, st.keyframesCreated);
-		std::snprintf(m, sizeof(m), "  \"mean_inliers\": %.1f,\n  \"mean_ba_keyframes\": %.1f,\n  \"mean_ba_observations\": %.1f,\n  \"mean_ba_outliers\": %.1f,\n",
-					  st.sumInliers / std::max<std::size_t>(1, st.frames), st.sumBaKeyFrames / kfs, st.sumBaObservations / kfs, st.sumBaOutliers / kfs);
+		std::snprintf(m, sizeof(m), "  \"mean_inliers\": %.1f,\n  \"mean_ba_keyframes\": %.1f,\n  \"mean_ba_observations\": %.1f,\n  \"mean_ba_outliers\": %.1f,\n  \"mean_ba_iterations\": %.2f,\n",
+					  st.sumInliers / std::max<std::size_t>(1, st.frames), st.sumBaKeyFrames / kfs, st.sumBaObservations / kfs, st.sumBaOutliers / kfs,
+					  st.sumBaIterations / kfs);
 		js << m;
 	}
 	char b[64];

@@ -42,7 +42,7 @@ struct SystemStats
 	 * fallback selection (sfm::Tracker::track). */
 	std::size_t landmarksPrunedHoc{0}, hocIncrements{0}, hocDecrements{0}, hocOccluded{0}, hocRecovered{0};
 	std::size_t hocSeenThrough{0}, hocFallbackFrames{0};
-	double sumInliers{0}, sumBaKeyFrames{0}, sumBaObservations{0}, sumBaOutliers{0};
+	double sumInliers{0}, sumBaKeyFrames{0}, sumBaObservations{0}, sumBaOutliers{0}, sumBaIterations{0};
 	/** Threaded mode: local bundle adjustments dropped because a loop closure moved the map
 	 * while they were solved. */
 	std::size_t baDiscarded{0};
