@@ -1,5 +1,6 @@
 #include <keygrid/sfm/FeatureExtractor.h>
 
+#include <algorithm>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -73,6 +74,41 @@ TEST(FeatureExtractor, OrbFeaturesWithDepthValidity)
 	int brute = 0;
 	for (const auto& p : f.undistorted) brute += cv::norm(p - cv::Point2f(300, 200)) <= 25;
 	EXPECT_EQ(static_cast<int>(near.size()), brute);
+}
+
+TEST(FeatureExtractor, AreaLookupsAgreeWithBruteForceAtEveryLevelRange)
+{
+	sfm::FeatureOptions o;
+	sfm::FeatureExtractor ex(o);
+	const auto f = ex.extract(texturedFrame(3));
+	ASSERT_GT(f.size(), 500u);
+	std::mt19937 g(7);
+	std::uniform_real_distribution<float> u(-20.f, 660.f), v(-20.f, 500.f), r(0.5f, 30.f);
+	std::vector<int> buffer{42, 43};  // stale content must be cleared
+	int nonEmpty = 0, empty = 0;
+	for (int q = 0; q < 400; q++)
+	{
+		const float cu = u(g), cv_ = v(g), rad = q % 4 == 0 ? 2.f : r(g);
+		const int minLevel = q % 3 == 0 ? -1 : q % 5, maxLevel = q % 3 == 0 ? -1 : q % 5 + 1;
+		std::vector<int> brute;
+		for (std::size_t i = 0; i < f.size(); i++)
+		{
+			const int lvl = f.keypoints[i].octave;
+			if (minLevel >= 0 && lvl < minLevel) continue;
+			if (maxLevel >= 0 && lvl > maxLevel) continue;
+			const float dx = f.undistorted[i].x - cu, dy = f.undistorted[i].y - cv_;
+			if (dx * dx + dy * dy <= rad * rad) brute.push_back(static_cast<int>(i));
+		}
+		auto grid = f.featuresInArea(cu, cv_, rad, minLevel, maxLevel);
+		f.featuresInArea(cu, cv_, rad, minLevel, maxLevel, buffer);
+		EXPECT_EQ(grid, buffer);
+		std::sort(grid.begin(), grid.end());
+		EXPECT_EQ(grid, brute) << "query " << q;
+		EXPECT_EQ(f.anyFeatureInArea(cu, cv_, rad, minLevel, maxLevel), !brute.empty()) << "query " << q;
+		(brute.empty() ? empty : nonEmpty)++;
+	}
+	EXPECT_GT(empty, 20);  // both answers exercised
+	EXPECT_GT(nonEmpty, 20);
 }
 
 TEST(FeatureExtractor, SiftIsSelectable)

@@ -21,10 +21,10 @@ void FrameFeatures::buildGrid(int cellSizePx)
 	}
 }
 
-std::vector<int> FrameFeatures::featuresInArea(float u, float v, float r, int minLevel, int maxLevel) const
+template <class Visit>
+void FrameFeatures::visitArea(float u, float v, float r, int minLevel, int maxLevel, Visit&& visit) const
 {
-	std::vector<int> out;
-	if (m_grid.empty()) return out;
+	if (m_grid.empty()) return;
 	const int x0 = std::clamp(static_cast<int>(std::floor((u - r) / m_cell)) + 1, 0, m_cols - 1);
 	const int x1 = std::clamp(static_cast<int>(std::floor((u + r) / m_cell)) + 1, 0, m_cols - 1);
 	const int y0 = std::clamp(static_cast<int>(std::floor((v - r) / m_cell)) + 1, 0, m_rows - 1);
@@ -38,9 +38,34 @@ std::vector<int> FrameFeatures::featuresInArea(float u, float v, float r, int mi
 				if (minLevel >= 0 && lvl < minLevel) continue;
 				if (maxLevel >= 0 && lvl > maxLevel) continue;
 				const float dx = undistorted[i].x - u, dy = undistorted[i].y - v;
-				if (dx * dx + dy * dy <= r2) out.push_back(i);
+				if (dx * dx + dy * dy <= r2 && !visit(i)) return;
 			}
+}
+
+void FrameFeatures::featuresInArea(float u, float v, float r, int minLevel, int maxLevel, std::vector<int>& out) const
+{
+	out.clear();
+	visitArea(u, v, r, minLevel, maxLevel, [&](int i) {
+		out.push_back(i);
+		return true;
+	});
+}
+
+std::vector<int> FrameFeatures::featuresInArea(float u, float v, float r, int minLevel, int maxLevel) const
+{
+	std::vector<int> out;
+	featuresInArea(u, v, r, minLevel, maxLevel, out);
 	return out;
+}
+
+bool FrameFeatures::anyFeatureInArea(float u, float v, float r, int minLevel, int maxLevel) const
+{
+	bool found = false;
+	visitArea(u, v, r, minLevel, maxLevel, [&](int) {
+		found = true;
+		return false;
+	});
+	return found;
 }
 
 float descriptorDistance(const cv::Mat& a, const cv::Mat& b) { return descriptorDistance(a, 0, b, 0); }

@@ -5,14 +5,22 @@
 
 #include <algorithm>
 #include <cmath>
-#include <set>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace keygrid::sfm
 {
 HocFrontend::HocFrontend(const maps::HocOptions& opts) : m_opts(opts), m_geom(opts.radii, opts.subdivisions)
 {
 	m_opts.validate();
+	// The sigmoid is evaluated for every landmark in view, twice per frame: tabulated.
+	for (int n = -m_opts.countLimit; n <= m_opts.countLimit; n++) m_weights.push_back(m_opts.weight(n));
+}
+
+double HocFrontend::weight(int n) const
+{
+	const int i = n + m_opts.countLimit;
+	return i >= 0 && i < static_cast<int>(m_weights.size()) ? m_weights[static_cast<std::size_t>(i)] : m_opts.weight(n);
 }
 
 void HocFrontend::seed(Landmark& lm, const SparseMap& map) const
@@ -47,7 +55,7 @@ bool HocFrontend::usable(Landmark& lm, const SparseMap& map, const Eigen::Vector
 	seed(lm, map);
 	const int b = m_geom.bin(lm.p_world, c);
 	const double threshold = fallback ? std::min(m_opts.selectThreshold, m_opts.weight(0)) : m_opts.selectThreshold;
-	return b < 0 || m_opts.weight(lm.hoc.count(b)) > threshold;
+	return b < 0 || weight(lm.hoc.count(b)) > threshold;
 }
 
 bool HocFrontend::fitsPose(const FrameFeatures& f, int kp, const ProjectedLandmark& p) const
@@ -79,7 +87,7 @@ bool HocFrontend::hasDepth(const cv::Mat& depth, float u, float v)
 bool HocFrontend::keypointInWindow(const FrameFeatures& f, const ProjectedLandmark& p, float radius)
 {
 	const float r = radius * static_cast<float>(f.levelScale.empty() ? 1.0 : f.levelScale[p.predictedLevel]);
-	return !f.featuresInArea(p.u, p.v, r, std::max(0, p.predictedLevel - 1), p.predictedLevel + 1).empty();
+	return f.anyFeatureInArea(p.u, p.v, r, std::max(0, p.predictedLevel - 1), p.predictedLevel + 1);
 }
 
 bool HocFrontend::occluded(const cv::Mat& depth, float u, float v, float predicted) const
@@ -121,16 +129,21 @@ HocUpdateStats HocFrontend::update(
 		lm.hoc.add(b, delta, m_opts.countLimit, nb);
 		(delta > 0 ? st.incremented : st.decremented)++;
 	};
-	std::set<LandmarkId> done;
+	// Membership tests only (nothing iterates these), so hash sets; results do not depend on it.
+	std::unordered_set<LandmarkId> done;
+	done.reserve(2 * (matched.size() + visible.size() + excluded.size()));
+	// One map lookup per landmark (findLandmark): the map is a std::map, each lookup a tree walk.
 	for (LandmarkId id : matched)
-		if (id != kNoLandmark && map.hasLandmark(id) && done.insert(id).second) bump(map.landmark(id), +1);
+		if (id != kNoLandmark && done.insert(id).second)
+			if (Landmark* lm = map.findLandmark(id)) bump(*lm, +1);
 
 	// Excluded landmarks: a guided search among the keypoints left free. Matches found here
 	// only feed the histogram, never the pose.
 	std::vector<LandmarkId> again(matched);
 	searchByProjection(f, excluded, searchRadius, matcherOpts, again);
-	std::set<LandmarkId> recovered;
+	std::unordered_set<LandmarkId> recovered;
 	std::unordered_map<LandmarkId, const ProjectedLandmark*> proj;
+	proj.reserve(2 * excluded.size());
 	for (const auto& p : excluded) proj[p.id] = &p;
 	for (std::size_t i = 0; i < again.size(); i++)
 		if (again[i] != kNoLandmark && again[i] != matched[i] && fitsPose(f, static_cast<int>(i), *proj.at(again[i])))
@@ -138,8 +151,9 @@ HocUpdateStats HocFrontend::update(
 
 	std::vector<LandmarkId> decremented;
 	auto miss = [&](const ProjectedLandmark& p) {
-		if (!done.insert(p.id).second || !map.hasLandmark(p.id)) return;
-		auto& lm = map.landmark(p.id);
+		Landmark* found = done.insert(p.id).second ? map.findLandmark(p.id) : nullptr;
+		if (!found) return;
+		auto& lm = *found;
 		seed(lm, map);
 		if (recovered.count(p.id))
 		{
@@ -181,7 +195,7 @@ HocUpdateStats HocFrontend::update(
 
 	// Pruning: only a decrement can take a landmark's maximum below the threshold.
 	for (LandmarkId id : decremented)
-		if (map.hasLandmark(id) && m_opts.weight(map.landmark(id).hoc.maxCount()) < m_opts.pruneThreshold)
+		if (const Landmark* lm = map.findLandmark(id); lm && weight(lm->hoc.maxCount()) < m_opts.pruneThreshold)
 		{
 			map.eraseLandmark(id);
 			st.pruned++;

@@ -169,6 +169,7 @@ void LocalMapper::fuseInto(
 	const auto T_cam_world = -kf.T_world_cam;
 	const Eigen::Vector3d center = kf.cameraCenter();
 	const float maxDist = f.isBinary() ? m_opts.fuseMaxDistanceOrb : m_matcher.maxDistanceSift * 0.8f;
+	std::vector<int> area;
 	for (LandmarkId id : lms)
 	{
 		if (!m_map.hasLandmark(id)) continue;
@@ -179,7 +180,8 @@ void LocalMapper::fuseInto(
 		const float r = m_opts.fuseRadius * static_cast<float>(f.levelScale[p.predictedLevel]);
 		int best = -1;
 		float bestD = maxDist + 1;
-		for (int i : f.featuresInArea(p.u, p.v, r, std::max(0, p.predictedLevel - 1), p.predictedLevel + 1))
+		f.featuresInArea(p.u, p.v, r, std::max(0, p.predictedLevel - 1), p.predictedLevel + 1, area);
+		for (int i : area)
 		{
 			const float d = f.depth[i];
 			if (d > 0 && std::abs(d - p.depth) > m_matcher.maxDepthError * p.depth) continue;

@@ -46,10 +46,11 @@ int searchByProjection(
 {
 	const float maxDist = o.maxDistance(f.isBinary());
 	int added = 0;
+	std::vector<int> idx;
 	for (const auto& c : cands)
 	{
 		const float r = radius * static_cast<float>(f.levelScale.empty() ? 1.0 : f.levelScale[c.predictedLevel]);
-		const auto idx = f.featuresInArea(c.u, c.v, r, std::max(0, c.predictedLevel - 1), c.predictedLevel + 1);
+		f.featuresInArea(c.u, c.v, r, std::max(0, c.predictedLevel - 1), c.predictedLevel + 1, idx);
 		float best = 1e30f, second = 1e30f;
 		int bestIdx = -1, bestLevel = -1, secondLevel = -1;
 		for (int i : idx)

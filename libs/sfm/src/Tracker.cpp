@@ -38,7 +38,12 @@ bool Tracker::hocUsable(LandmarkId id, const Current& cur)
 {
 	// Untimed: callers time whole selection passes. A thread-CPU clock read costs ~1 us here,
 	// more than the selection of one landmark, so timing each call inflated the HOC cost.
-	return !m_hoc || m_hoc->usable(m_map.landmark(id), m_map, translationOf(cur.T_world_cam), m_hocRelaxed);
+	return !m_hoc || hocUsable(m_map.landmark(id), cur);
+}
+
+bool Tracker::hocUsable(Landmark& lm, const Current& cur)
+{
+	return !m_hoc || m_hoc->usable(lm, m_map, translationOf(cur.T_world_cam), m_hocRelaxed);
 }
 
 TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
@@ -238,6 +243,9 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool
 	std::unordered_set<LandmarkId> seen;
 	seen.reserve(4096);
 	std::vector<ProjectedLandmark> inView;
+	// The landmarks of inView, found once: the map is a std::map (id order keeps runs
+	// deterministic), and each further lookup walks the tree again.
+	std::vector<Landmark*> inViewLm;
 	const auto T_cam_world = -cur.T_world_cam;
 	const Eigen::Vector3d center = translationOf(cur.T_world_cam);
 	for (KeyFrameId kfId : m_localKfs)
@@ -246,24 +254,29 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool
 		for (LandmarkId id : m_map.keyframe(kfId).landmarks)
 		{
 			if (id == kNoLandmark || already.count(id) || !seen.insert(id).second) continue;
-			const Landmark* lm = m_map.findLandmark(id);
+			Landmark* lm = m_map.findLandmark(id);
 			if (!lm) continue;
 			ProjectedLandmark p;
-			if (projectLandmark(*lm, T_cam_world, center, m_K, cur.features, m_opts.matcher, p)) inView.push_back(p);
+			if (projectLandmark(*lm, T_cam_world, center, m_K, cur.features, m_opts.matcher, p))
+			{
+				inView.push_back(p);
+				inViewLm.push_back(lm);
+			}
 		}
 	}
 	// HOC selection (everything passes without HOC), timed as one pass.
 	const double t0 = m_hoc ? threadCpuSeconds() : 0.0;
 	std::vector<ProjectedLandmark> out;
 	out.reserve(inView.size());
-	for (const auto& p : inView)
+	for (std::size_t i = 0; i < inView.size(); i++)
 	{
-		if (!hocUsable(p.id, cur))
+		const auto& p = inView[i];
+		if (!hocUsable(*inViewLm[i], cur))
 		{
 			if (forLocalMap) cur.hocExcluded.push_back(p);
 			continue;
 		}
-		if (forLocalMap) m_map.landmark(p.id).visibleCount++;
+		if (forLocalMap) inViewLm[i]->visibleCount++;
 		out.push_back(p);
 	}
 	if (m_hoc) m_hocSelectionSeconds += threadCpuSeconds() - t0;
@@ -425,12 +438,13 @@ void Tracker::updateHoc(Current& cur, TrackedFrame& out)
 	// Matches of the earlier stages that the final refinement rejected were in view too.
 	const auto T_cam_world = -cur.T_world_cam;
 	const Eigen::Vector3d centre = translationOf(cur.T_world_cam);
-	std::set<LandmarkId> finalMatches(cur.matches.begin(), cur.matches.end());
+	const std::unordered_set<LandmarkId> finalMatches(cur.matches.begin(), cur.matches.end());
 	for (LandmarkId id : cur.matchedBeforeLocalMap)
 	{
-		if (id == kNoLandmark || finalMatches.count(id) || !m_map.hasLandmark(id)) continue;
+		const Landmark* lm = id == kNoLandmark || finalMatches.count(id) ? nullptr : m_map.findLandmark(id);
+		if (!lm) continue;
 		ProjectedLandmark p;
-		if (projectLandmark(m_map.landmark(id), T_cam_world, centre, m_K, cur.features, m_opts.matcher, p)) cur.hocVisible.push_back(p);
+		if (projectLandmark(*lm, T_cam_world, centre, m_K, cur.features, m_opts.matcher, p)) cur.hocVisible.push_back(p);
 	}
 	out.hoc = m_hoc->update(m_map, cur.features, cur.matches, cur.hocVisible, cur.hocExcluded, cur.frame->depth, centre,
 							m_opts.radiusLocalMap, m_opts.matcher);

@@ -35,8 +35,16 @@ struct FrameFeatures
 	/** Indices of keypoints whose undistorted position lies within radius r of (u, v) and whose
 	 * level is in [minLevel, maxLevel] (-1: unbounded). */
 	std::vector<int> featuresInArea(float u, float v, float r, int minLevel = -1, int maxLevel = -1) const;
+	/** The same into `out` (cleared first), reusing its memory across calls. */
+	void featuresInArea(float u, float v, float r, int minLevel, int maxLevel, std::vector<int>& out) const;
+	/** Whether featuresInArea would return anything (stops at the first keypoint found). */
+	bool anyFeatureInArea(float u, float v, float r, int minLevel = -1, int maxLevel = -1) const;
 
    private:
+	/** Calls visit(i) for each keypoint of the area in grid order until it returns false. */
+	template <class Visit>
+	void visitArea(float u, float v, float r, int minLevel, int maxLevel, Visit&& visit) const;
+
 	int m_cell{16}, m_cols{0}, m_rows{0};
 	std::vector<std::vector<int>> m_grid;
 };

@@ -97,9 +97,13 @@ class HocFrontend
 	void setResidualGate(const PoseOptimizerOptions& o) { m_gate = o; }
 
    private:
+	/** m_opts.weight(n), from a table for |n| <= count_limit (counts are clamped to it). */
+	double weight(int n) const;
+
 	PoseOptimizerOptions m_gate;
 	maps::HocOptions m_opts;
 	maps::HocGeometry m_geom;
+	std::vector<double> m_weights;  // weight(n) at index n + count_limit
 };
 
 }  // namespace keygrid::sfm

@@ -121,6 +121,7 @@ class Tracker
 	std::vector<ProjectedLandmark> projectLocalLandmarks(Current& cur, bool forLocalMap);
 	/** HOC selection of one landmark for cur's camera (always true without HOC). */
 	bool hocUsable(LandmarkId id, const Current& cur);
+	bool hocUsable(Landmark& lm, const Current& cur);
 	/** HOC update and pruning after the pose of cur is final. */
 	void updateHoc(Current& cur, TrackedFrame& out);
 	bool needKeyFrame(const Current& cur) const;
