@@ -68,3 +68,22 @@ TEST(SparseMap, ErasedKeyFramePosesFollowTheirParent)
 	EXPECT_NEAR((T.asVectorVal() - T_a_b.asVectorVal()).norm(), 0.0, 1e-12);
 	EXPECT_FALSE(m.poseOf(99, T));
 }
+
+TEST(SparseMap, ResolveFollowsFusionsToTheSurvivingLandmark)
+{
+	SparseMap m;
+	const auto a = m.addKeyFrame(makeKf(CPose3D(), 10)).id;
+	const auto b = m.addKeyFrame(makeKf(CPose3D(0.1, 0, 0, 0, 0, 0), 10)).id;
+	const auto l0 = m.addLandmark({0, 0, 2}, a, 0);
+	const auto l1 = m.addLandmark({0, 0.01, 2}, b, 1);
+	const auto l2 = m.addLandmark({0, 0.02, 2}, a, 2);
+	EXPECT_EQ(m.resolve(l0), l0);
+	m.replaceLandmark(l0, l1);  // l0 -> l1
+	m.replaceLandmark(l1, l2);  // l1 -> l2, so l0 -> l2
+	EXPECT_EQ(m.resolve(l0), l2);
+	EXPECT_EQ(m.resolve(l1), l2);
+	EXPECT_EQ(m.resolve(l2), l2);
+	m.eraseLandmark(l2);
+	EXPECT_EQ(m.resolve(l0), kNoLandmark);
+	EXPECT_EQ(m.resolve(12345), kNoLandmark);
+}

@@ -2,6 +2,7 @@
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <ceres/ceres.h>
+#include <algorithm>
 #include <array>
 #include <set>
 
@@ -315,17 +316,23 @@ BundleAdjusterReport BundleAdjustment::apply(SparseMap& map)
 			map.eraseObservation(lm, kf);
 			rep.outliersRemoved++;
 		}
+	std::vector<double> chi2;
+	chi2.reserve(m->all.size());
 	for (const auto& ob : m->all)
 	{
 		double cost = 0;
 		m->problem.EvaluateResidualBlock(ob.block, false, &cost, nullptr, nullptr);
 		// EvaluateResidualBlock(apply_loss_function=false) gives 0.5 |r|^2.
+		chi2.push_back(2.0 * cost);
 		if (2.0 * cost > (ob.rgbd ? o.chi2Rgbd : o.chi2Mono) && map.hasLandmark(ob.lm))
 		{
 			map.eraseObservation(ob.lm, ob.kf);
 			rep.outliersRemoved++;
 		}
 	}
+	const auto mid = chi2.begin() + static_cast<std::ptrdiff_t>(chi2.size() / 2);
+	std::nth_element(chi2.begin(), mid, chi2.end());
+	rep.medianChi2 = *mid;
 	for (LandmarkId lm : m->lms)
 		if (map.hasLandmark(lm)) map.updateLandmarkStats(lm);
 	return rep;

@@ -133,7 +133,15 @@ void SparseMap::replaceLandmark(LandmarkId gone, LandmarkId keep)
 	for (const auto& [kf, kp] : obs)
 		if (m_keyframes.at(kf).landmarks[kp] == gone) m_keyframes.at(kf).landmarks[kp] = kNoLandmark;
 	m_landmarks.erase(gone);
+	m_replacedBy[gone] = keep;
 	updateLandmarkStats(keep);
+}
+
+LandmarkId SparseMap::resolve(LandmarkId id) const
+{
+	// Each fusion maps an existing landmark onto another existing one, so the chain ends.
+	for (auto r = m_replacedBy.find(id); r != m_replacedBy.end(); r = m_replacedBy.find(id)) id = r->second;
+	return hasLandmark(id) ? id : kNoLandmark;
 }
 
 void SparseMap::updateLandmarkStats(LandmarkId id)

@@ -67,6 +67,16 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		return out;
 	}
 
+	// Rolling shutter: keypoints moved to the frame's timestamp, first with the rates of the
+	// last step (the motion model's), after tracking with those of the step just estimated.
+	std::optional<RollingShutterCompensator> rs;
+	if (m_opts.rollingShutterReadout > 0)
+	{
+		rs.emplace(cur.features, m_opts.rollingShutterReadout);
+		if (m_state == TrackingState::Ok && m_velocity && m_velocityDt > 0)
+			rs->apply(cur.features, ratesFromRelativePose(*m_velocity, m_velocityDt), m_K);
+	}
+
 	bool ok = attempt(cur, out);
 	// HOC: a strict selection (select_threshold above p(0)) leaves only confirmed points; after
 	// fast motion into new ground, or once lost, those may be too few while the points of the
@@ -88,12 +98,16 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		if (!ok) out.method = method;
 	}
 
+	if (ok && rs && m_state == TrackingState::Ok) recompensateRollingShutter(cur, *rs);
+
 	out.matches = static_cast<int>(std::count_if(cur.matches.begin(), cur.matches.end(), [](LandmarkId l) { return l != kNoLandmark; }));
 	out.inliers = cur.inliers;
 	if (ok)
 	{
 		m_velocity = cur.T_world_cam - m_lastPose;  // inv(last) * cur
+		m_velocityDt = m_state == TrackingState::Ok ? stepDuration(frame.timestamp) : 0.0;
 		m_lastPose = cur.T_world_cam;
+		m_lastTimestamp = frame.timestamp;
 		m_state = TrackingState::Ok;
 		m_framesLost = 0;
 		if (out.method != "relocalization" && cur.localMapInView > 0)
@@ -141,6 +155,23 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 	else
 		m_lastRelative.reset();
 	return out;
+}
+
+double Tracker::stepDuration(double timestamp) const
+{
+	// Rates are averaged over the step: beyond a few frames (dropped frames, a pause in the
+	// input) the average says little about the motion during one exposure.
+	constexpr double kMaxStep = 0.1;
+	const double dt = timestamp - m_lastTimestamp;
+	return dt > 0 && dt <= kMaxStep ? dt : 0.0;
+}
+
+void Tracker::recompensateRollingShutter(Current& cur, const RollingShutterCompensator& rs)
+{
+	const double dt = stepDuration(cur.frame->timestamp);
+	if (dt <= 0) return;
+	rs.apply(cur.features, ratesFromRelativePose(cur.T_world_cam - m_lastPose, dt), m_K);
+	cur.inliers = refinePose(cur);
 }
 
 bool Tracker::attempt(Current& cur, TrackedFrame& out)
@@ -222,7 +253,9 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	m_lastKfFrame = cur.frame->index;
 	m_localKfs = {id};
 	m_lastPose = cur.T_world_cam;
+	m_lastTimestamp = cur.frame->timestamp;
 	m_velocity.reset();
+	m_velocityDt = 0;
 	m_state = TrackingState::Ok;
 	out.tracked = true;
 	out.method = "init";

@@ -43,6 +43,9 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	pose.rounds = c.read_int(s, "pose_rounds", pose.rounds);
 	pose.iterationsPerRound = c.read_int(s, "pose_iterations", pose.iterationsPerRound);
 	pnp.seed = static_cast<uint64_t>(c.read_uint64_t(s, "seed", pnp.seed));
+	rollingShutterReadout = c.read_double(s, "rolling_shutter_readout", rollingShutterReadout);
+	if (!(rollingShutterReadout >= 0 && rollingShutterReadout < 1))
+		throw std::invalid_argument("[" + s + "] rolling_shutter_readout = " + std::to_string(rollingShutterReadout) + " s (must be in [0, 1))");
 	positive(s, "min_init_features", minInitFeatures);
 	positive(s, "radius_prediction", radiusPrediction);
 	positive(s, "radius_local_map", radiusLocalMap);
@@ -94,6 +97,7 @@ void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "pose_rounds", pose.rounds, 34, 40, "outlier rounds of pose refinement");
 	c.write(s, "pose_iterations", pose.iterationsPerRound, 34, 40, "iterations per round");
 	c.write(s, "seed", pnp.seed, 34, 40, "RANSAC seed");
+	c.write(s, "rolling_shutter_readout", rollingShutterReadout, 34, 40, "first-to-last row exposure time [s]; 0 = global shutter");
 }
 
 double requiredRelocalizationShare(const TrackerOptions& o, std::vector<double> recent)

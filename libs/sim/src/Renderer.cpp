@@ -13,23 +13,12 @@ namespace keygrid::sim
 {
 namespace
 {
-/** An object prepared for one frame: its local frame seen from the camera. */
-struct Prepared
-{
-	int object{-1};
-	const Shape* shape{nullptr};
-	Eigen::Matrix3d R_obj_cam;         //!< rotates optical-frame directions into the object frame
-	Eigen::Vector3d o_obj;             //!< camera centre in the object frame
-	Eigen::Vector3d n_light_obj;       //!< light direction in the object frame
-	int x0{0}, x1{-1}, y0{0}, y1{-1};  //!< inclusive pixel rectangle that may be hit
-};
-
 /** Pixel rectangle covering the projection of the part of the object's bounding box in front
  * of the near plane: projected corners plus the points where box edges cross the near plane.
  * Returns false when nothing is in front of the camera or the rectangle misses the image. */
 bool screenRect(
 	const Shape& shape, const Eigen::Isometry3d& T_cam_obj, const core::RgbdCamera& cam,
-	double nearZ, Prepared& p)
+	double nearZ, Renderer::PreparedObject& p)
 {
 	const auto corners = shape.boundingCorners();
 	std::array<Eigen::Vector3d, 8> c;
@@ -108,18 +97,12 @@ void Renderer::render(const mrpt::poses::CPose3D& T_world_cam, double t, RenderO
 	render(toIsometry(T_world_cam), t, out);
 }
 
-void Renderer::render(const Eigen::Isometry3d& T_world_cam, double t, RenderOutput& out) const
+std::vector<Renderer::PreparedObject> Renderer::prepare(const Eigen::Isometry3d& T_world_cam, double t) const
 {
 	const core::RgbdCamera& cam = m_scene.camera;
-	const int W = static_cast<int>(cam.width), H = static_cast<int>(cam.height);
-	out.colour.create(H, W, CV_8UC3);
-	out.depth.create(H, W, CV_32FC1);
-	out.cosIncidence.create(H, W, CV_32FC1);
-	out.objectIndex.create(H, W, CV_32SC1);
-
 	const Eigen::Isometry3d T_cam_world = T_world_cam.inverse();
 	const Eigen::Vector3d light_world = m_scene.options.lightDirection.normalized();
-	std::vector<Prepared> objs;
+	std::vector<PreparedObject> objs;
 	objs.reserve(m_scene.objects.size());
 	for (std::size_t i = 0; i < m_scene.objects.size(); i++)
 	{
@@ -127,7 +110,7 @@ void Renderer::render(const Eigen::Isometry3d& T_world_cam, double t, RenderOutp
 		if (!o.visibleAt(t)) continue;
 		const Eigen::Isometry3d T_world_obj = o.poseAt(t);
 		const Eigen::Isometry3d T_cam_obj = T_cam_world * T_world_obj;
-		Prepared p;
+		PreparedObject p;
 		if (m_rays.empty())
 		{
 			if (!screenRect(o.shape, T_cam_obj, cam, m_opts.nearClip, p)) continue;
@@ -135,8 +118,8 @@ void Renderer::render(const Eigen::Isometry3d& T_world_cam, double t, RenderOutp
 		else
 		{
 			p.x0 = p.y0 = 0;  // distorted camera: no culling
-			p.x1 = W - 1;
-			p.y1 = H - 1;
+			p.x1 = static_cast<int>(cam.width) - 1;
+			p.y1 = static_cast<int>(cam.height) - 1;
 		}
 		p.object = static_cast<int>(i);
 		p.shape = &o.shape;
@@ -145,7 +128,45 @@ void Renderer::render(const Eigen::Isometry3d& T_world_cam, double t, RenderOutp
 		p.n_light_obj = T_world_obj.linear().transpose() * light_world;
 		objs.push_back(p);
 	}
+	return objs;
+}
 
+void Renderer::allocate(RenderOutput& out) const
+{
+	const int W = static_cast<int>(m_scene.camera.width), H = static_cast<int>(m_scene.camera.height);
+	out.colour.create(H, W, CV_8UC3);
+	out.depth.create(H, W, CV_32FC1);
+	out.cosIncidence.create(H, W, CV_32FC1);
+	out.objectIndex.create(H, W, CV_32SC1);
+}
+
+void Renderer::render(const Eigen::Isometry3d& T_world_cam, double t, RenderOutput& out) const
+{
+	allocate(out);
+	const auto objs = prepare(T_world_cam, t);
+	parallelRows(static_cast<int>(m_scene.camera.height), m_opts.threads, [&](int r0, int r1) { renderRows(objs, r0, r1, out); });
+}
+
+void Renderer::renderRollingShutter(
+	const std::function<Eigen::Isometry3d(double)>& poseAt, double t, double readout, RenderOutput& out) const
+{
+	if (!(readout >= 0)) throw std::invalid_argument("renderRollingShutter: readout = " + std::to_string(readout) + " s (must be >= 0)");
+	allocate(out);
+	const int H = static_cast<int>(m_scene.camera.height);
+	parallelRows(H, m_opts.threads, [&](int r0, int r1) {
+		for (int y = r0; y < r1; y++)
+		{
+			// Row y is exposed at t + (y / H - 1/2) readout (RollingShutter.h in libs/sfm).
+			const double ty = t + (static_cast<double>(y) / H - 0.5) * readout;
+			renderRows(prepare(poseAt(ty), ty), y, y + 1, out);
+		}
+	});
+}
+
+void Renderer::renderRows(const std::vector<PreparedObject>& objs, int r0, int r1, RenderOutput& out) const
+{
+	const core::RgbdCamera& cam = m_scene.camera;
+	const int W = static_cast<int>(cam.width);
 	std::vector<double> rayX(W);
 	for (int x = 0; x < W; x++) rayX[x] = (x - cam.cx) / cam.fx;
 	const bool distorted = !m_rays.empty();
@@ -158,72 +179,70 @@ void Renderer::render(const Eigen::Isometry3d& T_world_cam, double t, RenderOutp
 	const double ambient = m_scene.options.ambient;
 	const double nearZ = m_opts.nearClip;
 
-	parallelRows(H, m_opts.threads, [&](int r0, int r1) {
-		std::vector<double> zbuf(W);
-		std::vector<int> hitObj(W), hitFace(W);
-		for (int y = r0; y < r1; y++)
+	std::vector<double> zbuf(W);
+	std::vector<int> hitObj(W), hitFace(W);
+	for (int y = r0; y < r1; y++)
+	{
+		std::fill(zbuf.begin(), zbuf.end(), std::numeric_limits<double>::infinity());
+		std::fill(hitObj.begin(), hitObj.end(), -1);
+		const double ry = (y - cam.cy) / cam.fy;
+		for (std::size_t k = 0; k < objs.size(); k++)
 		{
-			std::fill(zbuf.begin(), zbuf.end(), std::numeric_limits<double>::infinity());
-			std::fill(hitObj.begin(), hitObj.end(), -1);
-			const double ry = (y - cam.cy) / cam.fy;
-			for (std::size_t k = 0; k < objs.size(); k++)
+			const PreparedObject& p = objs[k];
+			if (y < p.y0 || y > p.y1) continue;
+			const Eigen::Vector3d base = p.R_obj_cam.col(1) * ry + p.R_obj_cam.col(2);
+			for (int x = p.x0; x <= p.x1; x++)
 			{
-				const Prepared& p = objs[k];
-				if (y < p.y0 || y > p.y1) continue;
-				const Eigen::Vector3d base = p.R_obj_cam.col(1) * ry + p.R_obj_cam.col(2);
-				for (int x = p.x0; x <= p.x1; x++)
+				const Eigen::Vector3d d =
+					distorted ? Eigen::Vector3d(p.R_obj_cam * ray(x, y, ry))
+							  : Eigen::Vector3d(p.R_obj_cam.col(0) * rayX[x] + base);
+				LocalHit h;
+				if (p.shape->intersect(p.o_obj, d, nearZ, zbuf[x], h))
 				{
-					const Eigen::Vector3d d =
-						distorted ? Eigen::Vector3d(p.R_obj_cam * ray(x, y, ry))
-								  : Eigen::Vector3d(p.R_obj_cam.col(0) * rayX[x] + base);
-					LocalHit h;
-					if (p.shape->intersect(p.o_obj, d, nearZ, zbuf[x], h))
-					{
-						zbuf[x] = h.t;
-						hitObj[x] = static_cast<int>(k);
-						hitFace[x] = h.face;
-					}
+					zbuf[x] = h.t;
+					hitObj[x] = static_cast<int>(k);
+					hitFace[x] = h.face;
 				}
-			}
-			// Shade the winners.
-			auto* colour = out.colour.ptr<cv::Vec3b>(y);
-			auto* depth = out.depth.ptr<float>(y);
-			auto* cosI = out.cosIncidence.ptr<float>(y);
-			auto* index = out.objectIndex.ptr<int>(y);
-			for (int x = 0; x < W; x++)
-			{
-				if (hitObj[x] < 0)
-				{
-					colour[x] = cv::Vec3b(0, 0, 0);
-					depth[x] = 0;
-					cosI[x] = 0;
-					index[x] = -1;
-					continue;
-				}
-				const Prepared& p = objs[hitObj[x]];
-				const double z = zbuf[x];
-				const Eigen::Vector3d d = p.R_obj_cam * ray(x, y, ry);
-				const Eigen::Vector3d q = p.o_obj + z * d;
-				Eigen::Vector3d n = p.shape->normal(q, hitFace[x]);
-				if (n.dot(d) > 0) n = -n;  // two-sided quads: the face towards the camera
-				const double c = std::abs(n.dot(d)) / d.norm();
-				const Eigen::Vector2d uv = p.shape->surfaceUV(q, hitFace[x]);
-				// Surface metres under one pixel: z / f, stretched by the slant.
-				const double footprint = z * d.norm() / (std::abs(cam.fx) * std::max(c, 0.2));
-				float bgr[3];
-				m_scene.textures[m_scene.objects[p.object].texture]->sample(
-					uv.x(), uv.y(), footprint, bgr);
-				const double shade =
-					ambient + (1.0 - ambient) * std::max(0.0, n.dot(p.n_light_obj));
-				for (int ch = 0; ch < 3; ch++)
-					colour[x][ch] = static_cast<unsigned char>(
-						std::clamp(std::lround(bgr[ch] * shade), 0L, 255L));
-				depth[x] = static_cast<float>(z);
-				cosI[x] = static_cast<float>(c);
-				index[x] = p.object;
 			}
 		}
-	});
+		// Shade the winners.
+		auto* colour = out.colour.ptr<cv::Vec3b>(y);
+		auto* depth = out.depth.ptr<float>(y);
+		auto* cosI = out.cosIncidence.ptr<float>(y);
+		auto* index = out.objectIndex.ptr<int>(y);
+		for (int x = 0; x < W; x++)
+		{
+			if (hitObj[x] < 0)
+			{
+				colour[x] = cv::Vec3b(0, 0, 0);
+				depth[x] = 0;
+				cosI[x] = 0;
+				index[x] = -1;
+				continue;
+			}
+			const PreparedObject& p = objs[hitObj[x]];
+			const double z = zbuf[x];
+			const Eigen::Vector3d d = p.R_obj_cam * ray(x, y, ry);
+			const Eigen::Vector3d q = p.o_obj + z * d;
+			Eigen::Vector3d n = p.shape->normal(q, hitFace[x]);
+			if (n.dot(d) > 0) n = -n;  // two-sided quads: the face towards the camera
+			const double c = std::abs(n.dot(d)) / d.norm();
+			const Eigen::Vector2d uv = p.shape->surfaceUV(q, hitFace[x]);
+			// Surface metres under one pixel: z / f, stretched by the slant.
+			const double footprint = z * d.norm() / (std::abs(cam.fx) * std::max(c, 0.2));
+			float bgr[3];
+			m_scene.textures[m_scene.objects[p.object].texture]->sample(
+				uv.x(), uv.y(), footprint, bgr);
+			const double shade =
+				ambient + (1.0 - ambient) * std::max(0.0, n.dot(p.n_light_obj));
+			for (int ch = 0; ch < 3; ch++)
+				colour[x][ch] = static_cast<unsigned char>(
+					std::clamp(std::lround(bgr[ch] * shade), 0L, 255L));
+			depth[x] = static_cast<float>(z);
+			cosI[x] = static_cast<float>(c);
+			index[x] = p.object;
+		}
+	}
 }
 
 }  // namespace keygrid::sim

@@ -280,7 +280,7 @@ Scene Scene::loadFromConfig(
 			cfg, "sensor",
 			{"noise", "sigma_a", "sigma_b", "sigma_z0", "quantise_disparity", "baseline",
 			 "disparity_subpixel", "min_range", "max_range", "max_incidence_deg",
-			 "dropout_probability", "image_noise_sigma", "disparity_distortion"});
+			 "dropout_probability", "image_noise_sigma", "disparity_distortion", "rolling_shutter_readout"});
 		sc.sensor.loadFromConfigFile(cfg, "sensor");
 	}
 

@@ -29,6 +29,7 @@ void SensorOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
 	imageNoiseSigma = ini::readDouble(c, s, "image_noise_sigma", imageNoiseSigma, 0, 100);
 	disparityDistortion =
 		ini::readDouble(c, s, "disparity_distortion", disparityDistortion, -5, 5);
+	rollingShutterReadout = ini::readDouble(c, s, "rolling_shutter_readout", rollingShutterReadout, 0, 1);
 	try
 	{
 		validate();
@@ -54,6 +55,7 @@ void SensorOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std
 	c.write(s, "dropout_probability", dropoutProbability);
 	c.write(s, "image_noise_sigma", imageNoiseSigma);
 	c.write(s, "disparity_distortion", disparityDistortion);
+	c.write(s, "rolling_shutter_readout", rollingShutterReadout);
 }
 
 void SensorOptions::validate() const

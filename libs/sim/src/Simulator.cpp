@@ -35,7 +35,16 @@ Simulator::Simulator(const Scene& scene, unsigned threads)
 
 void Simulator::frame(std::size_t i, SimFrame& out) const
 {
-	view(m_scene.cameraPose(i), m_scene.frameTime(i), i, out);
+	const double readout = m_scene.sensor.rollingShutterReadout;
+	if (readout > 0)
+	{
+		// Rolling shutter: each row from the trajectory's pose at its own exposure time.
+		const auto& traj = m_scene.trajectory;
+		m_renderer.renderRollingShutter([&](double t) { return Renderer::toIsometry(traj.poseAt(t)); }, m_scene.frameTime(i), readout, out.render);
+		finishView(m_scene.cameraPose(i), i, out);
+	}
+	else
+		view(m_scene.cameraPose(i), m_scene.frameTime(i), i, out);
 	out.frame.index = i;
 	out.frame.timestamp = m_scene.timestamp(i);
 }
@@ -43,11 +52,16 @@ void Simulator::frame(std::size_t i, SimFrame& out) const
 void Simulator::view(
 	const mrpt::poses::CPose3D& T_world_cam, double t, std::size_t noiseIndex, SimFrame& out) const
 {
-	out.T_world_cam = T_world_cam;
 	m_renderer.render(T_world_cam, t, out.render);
+	finishView(T_world_cam, noiseIndex, out);
+	out.frame.timestamp = m_scene.options.startTime + t;
+}
+
+void Simulator::finishView(const mrpt::poses::CPose3D& T_world_cam, std::size_t noiseIndex, SimFrame& out) const
+{
+	out.T_world_cam = T_world_cam;
 	core::Frame& f = out.frame;
 	f.index = noiseIndex;
-	f.timestamp = m_scene.options.startTime + t;
 	f.camera = m_scene.camera;
 	f.colour = out.render.colour.clone();
 	cv::Mat depth;

@@ -274,7 +274,7 @@ void System::finish()
 		o.iterations = m_cfg.refinement.globalIterations;
 		// Once per run: to convergence (Ceres' default tolerance), not the local windows' early stop.
 		o.functionTolerance = 1e-6;
-		sfm::globalBundleAdjustment(m_map, *m_K, o);
+		m_globalBa = sfm::globalBundleAdjustment(m_map, *m_K, o);
 	}
 	m_timings.add("global_bundle_adjustment", secondsSince(t0));
 	if (m_maps)
@@ -308,7 +308,8 @@ void System::finish()
 			std::vector<sfm::PoseObservation> obs;
 			for (std::size_t k = 0; k < f.observations.size(); k++)
 			{
-				const sfm::Landmark* lm = map.findLandmark(f.observedLandmarks[k]);
+				// A landmark fused into another since the frame matched it: use the survivor.
+				const sfm::Landmark* lm = map.findLandmark(map.resolve(f.observedLandmarks[k]));
 				if (!lm) continue;
 				auto ob = f.observations[k];
 				ob.p_world = lm->p_world;

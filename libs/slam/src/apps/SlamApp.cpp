@@ -405,6 +405,13 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 					  st.sumBaIterations / kfs);
 		js << m;
 	}
+	if (const auto& ba = sys.globalBundleAdjustmentReport())
+	{
+		char g[256];
+		std::snprintf(g, sizeof(g), "  \"global_ba\": {\"keyframes\": %d, \"landmarks\": %d, \"observations\": %d, \"outliers\": %d, \"iterations\": %d, \"median_chi2\": %.4f},\n",
+					  ba->keyframes, ba->landmarks, ba->observations, ba->outliersRemoved, ba->iterations, ba->medianChi2);
+		js << g;
+	}
 	char b[64];
 	std::snprintf(b, sizeof(b), "%.3f", res.fps);
 	js << "  \"fps\": " << b << ",\n";

@@ -30,8 +30,10 @@ struct FrameFeatures
 	std::size_t size() const { return keypoints.size(); }
 	bool isBinary() const { return descriptors.type() == CV_8U; }
 
-	/** Builds the lookup grid; call after filling `undistorted`. */
+	/** Builds the lookup grid; call after filling (or changing) `undistorted`. */
 	void buildGrid(int cellSizePx = 16);
+	/** Cell size of the lookup grid [px]. */
+	int gridCellSize() const { return m_cell; }
 	/** Indices of keypoints whose undistorted position lies within radius r of (u, v) and whose
 	 * level is in [minLevel, maxLevel] (-1: unbounded). */
 	std::vector<int> featuresInArea(float u, float v, float r, int minLevel = -1, int maxLevel = -1) const;

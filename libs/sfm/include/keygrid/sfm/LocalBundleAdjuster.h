@@ -75,6 +75,10 @@ struct BundleAdjusterReport
 	/** Levenberg-Marquardt iterations run (successful and rejected steps) */
 	int iterations{0};
 	double initialCost{0}, finalCost{0};
+	/** Median over all observations of the squared normalised residual |r|^2 after the solve
+	 * (outliers included, so the outlier gate does not bias it): a self-consistency measure
+	 * of the camera model that needs no ground truth (2-3 for a consistent RGB-D model). */
+	double medianChi2{0};
 };
 
 /** One bundle adjustment in three steps, so that threaded mode can solve without holding the

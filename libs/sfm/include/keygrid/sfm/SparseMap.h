@@ -85,6 +85,10 @@ class SparseMap
 	bool poseOf(KeyFrameId kf, mrpt::poses::CPose3D& T_world_kf) const;
 	/** Keeps `keep`, moves the observations of `gone` to it (duplicate fusion). */
 	void replaceLandmark(LandmarkId gone, LandmarkId keep);
+	/** The landmark that now stands for `id`: `id` itself, or the one it was fused into
+	 * (following later fusions too); kNoLandmark if that one was erased. Frames keep the ids
+	 * they matched; this maps them onto the current map. */
+	LandmarkId resolve(LandmarkId id) const;
 
 	/** Recomputes normal, distance limits and representative descriptor of a landmark. */
 	void updateLandmarkStats(LandmarkId lm);
@@ -125,6 +129,8 @@ class SparseMap
 	std::map<LandmarkId, Landmark> m_landmarks;
 	/** erased keyframe -> (parent, T_parent_kf) */
 	std::map<KeyFrameId, std::pair<KeyFrameId, mrpt::poses::CPose3D>> m_erased;
+	/** fused landmark -> the landmark that absorbed it (replaceLandmark) */
+	std::map<LandmarkId, LandmarkId> m_replacedBy;
 	KeyFrameId m_nextKf{0};
 	LandmarkId m_nextLm{0};
 	std::uint64_t m_corrections{0};

@@ -7,6 +7,7 @@
  */
 #include <keygrid/core/Frame.h>
 #include <keygrid/sfm/HocFrontend.h>
+#include <keygrid/sfm/RollingShutter.h>
 #include <keygrid/sfm/SparseMap.h>
 #include <keygrid/sfm/TrackerOptions.h>
 
@@ -122,6 +123,12 @@ class Tracker
 	/** HOC selection of one landmark for cur's camera (always true without HOC). */
 	bool hocUsable(LandmarkId id, const Current& cur);
 	bool hocUsable(Landmark& lm, const Current& cur);
+	/** Rolling shutter, after a successful attempt: the keypoints compensated again with the
+	 * rates of the step from the last frame to cur's pose, and the pose refined on them. */
+	void recompensateRollingShutter(Current& cur, const RollingShutterCompensator& rs);
+	/** Time since the last tracked frame when it is short enough to average rates over [s],
+	 * else 0. */
+	double stepDuration(double timestamp) const;
 	/** HOC update and pruning after the pose of cur is final. */
 	void updateHoc(Current& cur, TrackedFrame& out);
 	bool needKeyFrame(const Current& cur) const;
@@ -133,6 +140,8 @@ class Tracker
 	PinholeIntrinsics m_K;
 	mrpt::poses::CPose3D m_lastPose;
 	std::optional<mrpt::poses::CPose3D> m_velocity;  //!< T_last_cur of the last tracked step
+	double m_velocityDt{0};  //!< time that step took [s] (0: unknown)
+	double m_lastTimestamp{0};  //!< timestamp of the last tracked frame [s]
 	KeyFrameId m_refKf{0};
 	/** HOC: the current attempt uses the fallback selection (see track()) */
 	bool m_hocRelaxed{false};

@@ -67,6 +67,12 @@ struct TrackerOptions
 	/** New landmarks per keyframe: all close ones, and farther ones up to this total (Default: 100) */
 	int minNewLandmarksPerKeyFrame{100};
 
+	/** Rolling shutter: time between the exposure of the first and the last image row [s];
+	 * keypoints are moved to the frame's timestamp with the camera's estimated motion
+	 * (RollingShutter.h). 0 = global shutter (Default: 0; the shipped Kinect configurations
+	 * set the value calibrated on TUM fr1, doc/frontend.md "Rolling shutter") */
+	double rollingShutterReadout{0.0};
+
 	MatcherOptions matcher;
 	PoseOptimizerOptions pose;
 	PnpOptions pnp;

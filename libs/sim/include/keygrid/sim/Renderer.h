@@ -13,6 +13,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <vector>
 
 namespace keygrid::sim
@@ -43,10 +44,31 @@ class Renderer
 	/** Renders the scene at time t [s] seen from T_world_cam (optical frame). */
 	void render(const Eigen::Isometry3d& T_world_cam, double t, RenderOutput& out) const;
 	void render(const mrpt::poses::CPose3D& T_world_cam, double t, RenderOutput& out) const;
+	/** A rolling-shutter camera: row y is rendered at time t_y = t + (y / H - 1/2) readout
+	 * from poseAt(t_y), moving objects at t_y too (readout 0: render(poseAt(t), t, out)). */
+	void renderRollingShutter(
+		const std::function<Eigen::Isometry3d(double)>& poseAt, double t, double readout, RenderOutput& out) const;
 
 	static Eigen::Isometry3d toIsometry(const mrpt::poses::CPose3D& p);
 
+	/** An object prepared for one camera pose: its local frame seen from the camera. */
+	struct PreparedObject
+	{
+		int object{-1};
+		const Shape* shape{nullptr};
+		Eigen::Matrix3d R_obj_cam;         //!< rotates optical-frame directions into the object frame
+		Eigen::Vector3d o_obj;             //!< camera centre in the object frame
+		Eigen::Vector3d n_light_obj;       //!< light direction in the object frame
+		int x0{0}, x1{-1}, y0{0}, y1{-1};  //!< inclusive pixel rectangle that may be hit
+	};
+
    private:
+	/** The objects visible at time t, seen from T_world_cam, with their screen rectangles. */
+	std::vector<PreparedObject> prepare(const Eigen::Isometry3d& T_world_cam, double t) const;
+	/** Ray-casts and shades rows [r0, r1) of `out` against `objs`. */
+	void renderRows(const std::vector<PreparedObject>& objs, int r0, int r1, RenderOutput& out) const;
+	void allocate(RenderOutput& out) const;
+
 	const Scene& m_scene;
 	RenderOptions m_opts;
 	/** Per-pixel normalised ray (x_n, y_n), row-major; only for distorted cameras. */

@@ -55,6 +55,10 @@ struct SensorOptions
 	/** Fixed-pattern disparity distortion k [px]: the disparity offset at the image corners
 	 * (see the file comment); applied also with noise off; 0 disables (Default: 0) */
 	double disparityDistortion{0.0};
+	/** Rolling shutter: time between the exposure of the first and the last image row [s];
+	 * row y is rendered at t + (y / H - 1/2) readout from the camera's pose at that time
+	 * (colour and depth alike); 0 = global shutter (Default: 0) */
+	double rollingShutterReadout{0.0};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;

@@ -24,7 +24,8 @@ class Simulator
 	/** The scene must outlive the simulator. threads = 0: all cores. */
 	explicit Simulator(const Scene& scene, unsigned threads = 0);
 
-	/** Produces frame i (0 <= i < scene.options.frames). */
+	/** Produces frame i (0 <= i < scene.options.frames); with [sensor]
+	 * rolling_shutter_readout > 0 each row is rendered at its own exposure time. */
 	void frame(std::size_t i, SimFrame& out) const;
 	/** Renders and corrupts an arbitrary view; `noiseIndex` keys the noise pattern. */
 	void view(
@@ -36,6 +37,10 @@ class Simulator
 	const SensorModel& sensor() const { return m_sensor; }
 
    private:
+	/** Sensor model and packing of out.render (already rendered) into out.frame; sets
+	 * out.T_world_cam (the pose at the frame's timestamp). */
+	void finishView(const mrpt::poses::CPose3D& T_world_cam, std::size_t noiseIndex, SimFrame& out) const;
+
 	const Scene& m_scene;
 	Renderer m_renderer;
 	SensorModel m_sensor;

@@ -90,6 +90,8 @@ class System
 	SystemStats stats() const;
 	/** In threaded mode only after finish(). */
 	const std::vector<LoopClosureEvent>& loopClosures() const { return m_loops; }
+	/** Report of the final global bundle adjustment (finish()); empty when it did not run. */
+	const std::optional<sfm::BundleAdjusterReport>& globalBundleAdjustmentReport() const { return m_globalBa; }
 	/** Threaded mode: what stopped the mapping or loop-closing thread (empty if nothing did).
 	 * processExtracted() throws it; after finish() it is kept here. */
 	std::string backgroundError() const;
@@ -135,6 +137,7 @@ class System
 	std::unique_ptr<MetricMaps> m_maps;
 	std::unique_ptr<LoopCloser> m_loopCloser;
 	std::vector<LoopClosureEvent> m_loops;
+	std::optional<sfm::BundleAdjusterReport> m_globalBa;
 	double m_travelled{0};
 	std::optional<mrpt::poses::CPose3D> m_lastTrackedPose;
 	/** m_map.corrections() when the tracking side last re-based its travelled distance. */
