@@ -1,3 +1,4 @@
+#include <keygrid/core/ImageReading.h>
 #include <keygrid/core/RawlogFrameSource.h>
 #include <keygrid/core/TumFrameSource.h>
 #include <mrpt/system/filesystem.h>
@@ -27,9 +28,9 @@ void TumFrameSource::loadPair(std::size_t i, cv::Mat& colour, cv::Mat& depthRaw)
 	for (const auto* f : {&p.rgbPath, &p.depthPath})
 		if (!mrpt::system::fileExists(*f))
 			throw std::runtime_error("missing image '" + *f + "'");
-	colour = cv::imread(p.rgbPath, cv::IMREAD_COLOR);
+	colour = readImage(p.rgbPath, cv::IMREAD_COLOR);
 	if (colour.empty()) throw std::runtime_error("cannot decode image '" + p.rgbPath + "'");
-	depthRaw = cv::imread(p.depthPath, cv::IMREAD_ANYDEPTH);
+	depthRaw = readImage(p.depthPath, cv::IMREAD_ANYDEPTH);
 	if (depthRaw.empty()) throw std::runtime_error("cannot decode depth image '" + p.depthPath + "'");
 	if (depthRaw.type() != CV_16UC1)
 		throw std::runtime_error(
