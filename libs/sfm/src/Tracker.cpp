@@ -4,6 +4,7 @@
 #include <ctime>
 #include <numeric>
 #include <set>
+#include <stdexcept>
 #include <unordered_set>
 
 namespace keygrid::sfm
@@ -32,6 +33,14 @@ Tracker::Tracker(SparseMap& map, const TrackerOptions& opts) : m_map(map), m_opt
 		m_hoc.emplace(opts.hoc);
 		m_hoc->setResidualGate(opts.pose);
 	}
+}
+
+void Tracker::deferKeyFramesWhile(std::function<bool()> mappingBusy, double weakRatio)
+{
+	if (!(weakRatio > 0 && weakRatio <= 1))
+		throw std::invalid_argument("Tracker::deferKeyFramesWhile: weakRatio = " + std::to_string(weakRatio) + " (must be in (0, 1])");
+	m_mappingBusy = std::move(mappingBusy);
+	m_deferWeakRatio = weakRatio;
 }
 
 bool Tracker::hocUsable(LandmarkId id, const Current& cur)
@@ -503,6 +512,8 @@ bool Tracker::needKeyFrame(const Current& cur) const
 	const double ratio = m_map.numKeyFrames() < 2 ? 0.4 : m_opts.keyFrameTrackedRatio;
 	const bool timeout = sinceLast >= m_opts.maxFramesBetweenKeyFrames;
 	const bool weak = cur.inliers < ratio * refMatches || needClose;
+	// Local mapping still busy with the last keyframe: wait for it unless tracking is weak.
+	if (!timeout && m_mappingBusy && !(cur.inliers < m_deferWeakRatio * refMatches) && m_mappingBusy()) return false;
 	return (timeout || weak) && cur.inliers > 15;
 }
 

@@ -13,6 +13,9 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	mode = c.read_string("slam", "mode", mode);
 	camera = c.read_string("slam", "camera", camera);
 	mappingLag = c.read_int("slam", "mapping_lag", mappingLag);
+	busyKeyFrameRatio = c.read_double("slam", "busy_keyframe_ratio", busyKeyFrameRatio);
+	if (!(busyKeyFrameRatio >= 0 && busyKeyFrameRatio <= 1))
+		throw std::invalid_argument("[slam] busy_keyframe_ratio = " + std::to_string(busyKeyFrameRatio) + " (expected 0..1)");
 	if (mode != "sequential" && mode != "threaded")
 		throw std::invalid_argument("[slam] mode = '" + mode + "' (expected sequential or threaded)");
 	if (mappingLag < 0 || mappingLag > 5)
@@ -38,6 +41,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	c.write("slam", "mode", mode, 30, 40, "sequential | threaded");
 	c.write("slam", "camera", camera.empty() ? std::string("auto") : camera, 30, 40, "preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
 	c.write("slam", "mapping_lag", mappingLag, 30, 40, "threaded: keyframes local mapping may lag behind tracking (0: none)");
+	c.write("slam", "busy_keyframe_ratio", busyKeyFrameRatio, 30, 40, "threaded, lag > 0: no keyframe while mapping is busy unless tracking < this x reference (0: off)");
 	features.saveToConfigFile(c, "features");
 	tracker.saveToConfigFile(c, "tracker");
 	tracker.hoc.saveToConfigFile(c, "hoc");

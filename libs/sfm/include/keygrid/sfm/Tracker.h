@@ -69,6 +69,11 @@ class Tracker
 
 	/** When set, relocalization tries these candidates before the newest keyframes. */
 	void setPlaceRecognizer(PlaceRecognizer f) { m_placeRecognizer = std::move(f); }
+	/** Threaded mode (ORB-SLAM2's rule): while `mappingBusy()` says local mapping is still
+	 * working on a keyframe, a new one is inserted only at the keyframe timeout or when the
+	 * frame tracks fewer than `weakRatio` x the reference keyframe's landmarks. Fewer
+	 * keyframes, each of them mapped before the next; `weakRatio` in (0, 1]. */
+	void deferKeyFramesWhile(std::function<bool()> mappingBusy, double weakRatio);
 
 	/** Tracks one frame whose features were extracted by the caller. In threaded mode the
 	 * caller holds map.mutex() around this call (and around every other call). */
@@ -157,6 +162,8 @@ class Tracker
 	int m_framesLost{0};
 	std::optional<HocFrontend> m_hoc;
 	PlaceRecognizer m_placeRecognizer;
+	std::function<bool()> m_mappingBusy;  //!< see deferKeyFramesWhile (empty: never deferred)
+	double m_deferWeakRatio{0.25};
 	bool m_relocRecognized{false};  //!< the last relocalize() succeeded on a recognized place
 	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
 };

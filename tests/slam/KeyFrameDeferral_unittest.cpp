@@ -1,0 +1,94 @@
+// Threaded mode's keyframe deferral (Tracker::deferKeyFramesWhile, [slam] busy_keyframe_ratio),
+// made deterministic: the tracker and local mapping run in turn on a rendered sequence while
+// the "mapping busy" answer is fixed. Never busy: exactly the keyframes of the plain tracker.
+// Always busy: keyframes only where tracking is weak or, when no frame counts as weak, at the
+// [tracker] max_frames_between_keyframes timeout.
+#include <keygrid/core/FrameSource.h>
+#include <keygrid/sfm/FeatureExtractor.h>
+#include <keygrid/sfm/LocalMapper.h>
+#include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/SlamConfig.h>
+
+#include "TestData.h"
+
+#include <functional>
+#include <optional>
+
+using namespace keygrid;
+
+namespace
+{
+/** Frame indices that became keyframes, and the number of frames tracked (of those given to
+ * the tracker: every `stride`-th frame, at most maxFrames). */
+struct Run
+{
+	std::vector<std::size_t> keyframeFrames;
+	std::size_t tracked{0}, frames{0};
+};
+
+Run track(const std::string& tumDir, const std::optional<std::pair<std::function<bool()>, double>>& deferral, std::size_t maxFrames, std::size_t stride = 1)
+{
+	const auto cfg = slam::SlamConfig::FromFile(test::sourceDir() + "/config/sim.ini");
+	sfm::SparseMap map;
+	sfm::Tracker tracker(map, cfg.tracker);
+	if (deferral) tracker.deferKeyFramesWhile(deferral->first, deferral->second);
+	sfm::LocalMapper mapper(map, cfg.mapping, cfg.tracker.matcher);
+	const sfm::FeatureExtractor extractor(cfg.features);
+	auto source = core::openFrameSource(tumDir);
+	Run run;
+	core::Frame frame;
+	for (std::size_t i = 0; run.frames < maxFrames && source->next(frame); i++)
+	{
+		if (i % stride) continue;
+		const auto tf = tracker.track(frame, extractor.extract(frame));
+		run.frames++;
+		run.tracked += tf.tracked;
+		if (tf.newKeyFrame)
+		{
+			run.keyframeFrames.push_back(tf.index);
+			mapper.process(tf.keyframe, sfm::intrinsicsOf(frame.camera));
+		}
+	}
+	return run;
+}
+}  // namespace
+
+TEST(KeyFrameDeferral, BusyMappingDefersKeyFramesToWeakTrackingOrTheTimeout)
+{
+	// room_arc over 200 frames (slow enough that one keyframe's map holds for 30 frames); the
+	// first 100 are tracked.
+	const std::string dir = test::scratchDir("keyframe_deferral");
+	std::string log;
+	ASSERT_EQ(test::runCommand(test::toolPath("keygrid-sim") + " --quiet --scene " + test::dataDir() +
+								   "/sim/room_arc.ini --frames 200 --voxel-resolution 0 --floorplan-resolution 0 --output " + dir,
+							   &log),
+			  0)
+		<< log;
+	using Deferral = std::pair<std::function<bool()>, double>;
+	const auto plain = track(dir + "/tum", std::nullopt, 100);
+	ASSERT_EQ(plain.tracked, 100u);
+	ASSERT_GT(plain.keyframeFrames.size(), 6u);
+
+	int asked = 0;
+	const auto idle = track(dir + "/tum", Deferral([&] { return ++asked, false; }, 0.25), 100);
+	EXPECT_EQ(idle.keyframeFrames, plain.keyframeFrames);
+	EXPECT_GT(asked, 0);  // consulted, never deferring
+
+	// Busy, and no frame tracks below 1 % of its reference: only the timeout (config/sim.ini
+	// keeps the default of 30 frames) inserts keyframes.
+	const auto timeoutOnly = track(dir + "/tum", Deferral([] { return true; }, 0.01), 100);
+	EXPECT_EQ(timeoutOnly.tracked, 100u);
+	EXPECT_EQ(timeoutOnly.keyframeFrames, (std::vector<std::size_t>{0, 30, 60, 90}));
+
+	// Three times the motion per frame (every third frame): the timeout alone would come too
+	// late, but with the default share weak tracking still inserts keyframes, and every frame
+	// is tracked with fewer keyframes than without deferral.
+	const auto fastPlain = track(dir + "/tum", std::nullopt, 66, 3);
+	const auto fastBusy = track(dir + "/tum", Deferral([] { return true; }, 0.25), 66, 3);
+	EXPECT_EQ(fastBusy.tracked, 66u);
+	EXPECT_LT(fastBusy.keyframeFrames.size(), fastPlain.keyframeFrames.size());
+	bool beforeTimeout = false;
+	for (std::size_t k = 1; k < fastBusy.keyframeFrames.size(); k++)
+		beforeTimeout |= fastBusy.keyframeFrames[k] - fastBusy.keyframeFrames[k - 1] < 3 * 30;  // frame indices
+	EXPECT_TRUE(beforeTimeout);
+}
