@@ -41,15 +41,16 @@ struct SlamConfig
 	 * same trajectory byte for byte without loop closures); tracking and local mapping then
 	 * take turns. 1: local mapping works on a keyframe while tracking goes on, and
 	 * busy_keyframe_ratio keeps tracking from queueing more keyframes meanwhile: on fr1_rpy
-	 * 1.4x the frame rate of 0 at 1.49-1.83 cm instead of 1.49 (doc/frontend.md "Modes").
+	 * 1.25x the frame rate of 0 at 1.44-1.80 cm instead of 1.49 (doc/frontend.md "Modes").
 	 * At most 5 (the queue holds 4 waiting keyframes). (Default: 1) */
 	int mappingLag{1};
 	/** Threaded mode with mapping_lag > 0: while local mapping is still working on a keyframe,
 	 * tracking inserts a new one only at the keyframe timeout or when it tracks fewer than this
-	 * share of the reference keyframe's landmarks (ORB-SLAM2's rule); the frames in between
-	 * are tracked against the map being refined. 0 = insert whenever tracking asks, busy or
-	 * not. (Default: 0.25) */
-	double busyKeyFrameRatio{0.25};
+	 * share of the reference keyframe's landmarks (ORB-SLAM2's rule, which uses 0.25); the
+	 * frames in between are tracked against the map being refined. fr1_rpy, 5 runs each:
+	 * 0.25: 75-80 fps, 1.51-1.90 cm; 0.35: 64-72 fps, 1.32-1.73 cm; 0.5: 50-56 fps,
+	 * 1.34-1.45 cm. 0 = insert whenever tracking asks, busy or not. (Default: 0.35) */
+	double busyKeyFrameRatio{0.35};
 	sfm::FeatureOptions features;
 	sfm::TrackerOptions tracker;
 	sfm::LocalMapperOptions mapping;
