@@ -21,7 +21,7 @@ CameraRates ratesFromRelativePose(const mrpt::poses::CPose3D& T_a_b, double dt)
 }
 
 RollingShutterCompensator::RollingShutterCompensator(const FrameFeatures& f, double readout)
-	: m_readout(readout), m_measured(f.undistorted), m_depth(f.depth)
+	: m_measured(f.undistorted), m_depth(f.depth)
 {
 	if (!(readout >= 0)) throw std::invalid_argument("RollingShutterCompensator: readout = " + std::to_string(readout) + " s (must be >= 0)");
 	m_rowTime.reserve(f.size());

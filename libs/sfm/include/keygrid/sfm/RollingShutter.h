@@ -62,10 +62,7 @@ class RollingShutterCompensator
 	 * measurements. */
 	void apply(FrameFeatures& f, const CameraRates& rates, const PinholeIntrinsics& K) const;
 
-	double readout() const { return m_readout; }
-
    private:
-	double m_readout{0};
 	std::vector<cv::Point2f> m_measured;
 	std::vector<float> m_depth;
 	std::vector<float> m_rowTime;  // tau of each keypoint [s]

@@ -163,7 +163,7 @@ class Tracker
 	std::optional<HocFrontend> m_hoc;
 	PlaceRecognizer m_placeRecognizer;
 	std::function<bool()> m_mappingBusy;  //!< see deferKeyFramesWhile (empty: never deferred)
-	double m_deferWeakRatio{0.25};
+	double m_deferWeakRatio{0};  //!< set with m_mappingBusy
 	bool m_relocRecognized{false};  //!< the last relocalize() succeeded on a recognized place
 	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
 };
