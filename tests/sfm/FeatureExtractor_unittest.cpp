@@ -1,6 +1,7 @@
 #include <keygrid/sfm/FeatureExtractor.h>
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
@@ -123,4 +124,61 @@ TEST(FeatureExtractor, SiftIsSelectable)
 	EXPECT_EQ(f.descriptors.cols, 128);
 	o.type = "surf";
 	EXPECT_THROW(sfm::FeatureExtractor{o}, std::invalid_argument);
+}
+
+// OpenCV's ORB reports a keypoint found at integer pixel p_l of pyramid level l as p_l * 1.2^l.
+// Level l is made from level l-1 by cv::resize to the rounded size, so resampling a ramp image
+// I(u, v) = u (resp. v) the same way gives, at p_l, the level-0 position that pixel really sees:
+// the independent reference for levelZeroPosition().
+TEST(FeatureExtractor, PyramidKeypointsMapToLevelZeroThroughPixelCentres)
+{
+	sfm::FeatureOptions o;
+	sfm::FeatureExtractor ex(o);
+	const cv::Size size(640, 480);
+	cv::Mat rampU(size, CV_32FC1), rampV(size, CV_32FC1);
+	for (int r = 0; r < size.height; r++)
+		for (int c = 0; c < size.width; c++) rampU.at<float>(r, c) = c, rampV.at<float>(r, c) = r;
+	cv::Mat levelU = rampU, levelV = rampV;
+	double maxOpenCvError = 0;
+	for (int l = 1; l < o.numLevels; l++)
+	{
+		const float s = static_cast<float>(std::pow(o.scaleFactor, static_cast<double>(l)));
+		const cv::Size sz(cvRound(size.width / s), cvRound(size.height / s));
+		cv::resize(levelU, levelU, sz, 0, 0, cv::INTER_LINEAR);
+		cv::resize(levelV, levelV, sz, 0, 0, cv::INTER_LINEAR);
+		for (const cv::Point p : {cv::Point(3, 3), cv::Point(sz.width / 2, sz.height / 3), cv::Point(sz.width - 4, sz.height - 4)})
+		{
+			cv::KeyPoint kp(cv::Point2f(p.x * s, p.y * s), 31.f * s, -1, 1.f, l);
+			const cv::Point2f u0 = ex.levelZeroPosition(kp, size);
+			EXPECT_NEAR(u0.x, levelU.at<float>(p), 2e-3) << "level " << l << " pixel " << p;
+			EXPECT_NEAR(u0.y, levelV.at<float>(p), 2e-3) << "level " << l << " pixel " << p;
+			maxOpenCvError = std::max(maxOpenCvError, static_cast<double>(std::abs(kp.pt.x - levelU.at<float>(p))));
+		}
+	}
+	EXPECT_GT(maxOpenCvError, 1.0) << "OpenCV's own u_l * s^l is off by > 1 px at the top levels";
+
+	// The convention assumed above: detected keypoints sit at integer pixels of their level.
+	o.pyramidPixelCentres = false;
+	sfm::FeatureExtractor raw(o);
+	const auto f = raw.extract(texturedFrame(3));
+	int checked = 0;
+	for (const auto& kp : f.keypoints)
+	{
+		if (kp.octave == 0) continue;
+		const float s = static_cast<float>(std::pow(o.scaleFactor, static_cast<double>(kp.octave)));
+		EXPECT_NEAR(kp.pt.x / s, std::round(kp.pt.x / s), 1e-3);
+		EXPECT_NEAR(kp.pt.y / s, std::round(kp.pt.y / s), 1e-3);
+		++checked;
+	}
+	EXPECT_GT(checked, 100);
+	// With the option on, the same detections move by the mapping (level 0 stays put).
+	o.pyramidPixelCentres = true;
+	const auto g = sfm::FeatureExtractor(o).extract(texturedFrame(3));
+	ASSERT_EQ(g.size(), f.size());
+	for (std::size_t i = 0; i < f.size(); i++)
+	{
+		const cv::Point2f want = ex.levelZeroPosition(f.keypoints[i], size);
+		EXPECT_NEAR(g.keypoints[i].pt.x, want.x, 1e-4);
+		EXPECT_NEAR(g.undistorted[i].x - f.undistorted[i].x, 0.f, 2.f);
+	}
 }

@@ -22,6 +22,7 @@ void FeatureOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	minDepth = c.read_double(s, "min_depth", minDepth);
 	maxDepth = c.read_double(s, "max_depth", maxDepth);
 	maxDepthDiscontinuity = c.read_double(s, "max_depth_discontinuity", maxDepthDiscontinuity);
+	pyramidPixelCentres = c.read_bool(s, "pyramid_pixel_centres", pyramidPixelCentres);
 	std::string err;
 	if (!isValid(&err)) throw std::invalid_argument("[" + s + "] " + err);
 }
@@ -39,6 +40,7 @@ void FeatureOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "min_depth", minDepth, 30, 40, "valid depth range, lower end [m]");
 	c.write(s, "max_depth", maxDepth, 30, 40, "valid depth range, upper end [m]");
 	c.write(s, "max_depth_discontinuity", maxDepthDiscontinuity, 30, 40, "3x3 depth span / depth above which depth is rejected");
+	c.write(s, "pyramid_pixel_centres", pyramidPixelCentres, 30, 40, "ORB: map pyramid keypoints to level 0 through pixel centres");
 }
 
 bool FeatureOptions::isValid(std::string* error) const
@@ -135,6 +137,20 @@ float FeatureExtractor::depthAt(const cv::Mat& depth, float u, float v) const
 	return (hi - lo) > m_opts.maxDepthDiscontinuity * d ? 0.f : d;
 }
 
+// OpenCV's ORB builds level l from level l-1 with cv::resize to cvRound(W / s^l) x cvRound(H / s^l)
+// pixels. resize maps a destination pixel centre x to the source position (x + 0.5) * ratio - 0.5;
+// chaining the levels telescopes to u0 = (u_l + 0.5) * W / W_l - 0.5, whereas ORB reports
+// u_l * s^l: a shift of 0.5 (s^l - 1) px (1.3 px at level 7 with s = 1.2) plus the size rounding.
+cv::Point2f FeatureExtractor::levelZeroPosition(const cv::KeyPoint& kp, cv::Size size) const
+{
+	if (m_opts.type != "orb" || !m_opts.pyramidPixelCentres || kp.octave <= 0) return kp.pt;
+	// ORB's own float scale, so that pt / scale gives back the level's integer pixel exactly
+	const float s = static_cast<float>(std::pow(m_opts.scaleFactor, static_cast<double>(kp.octave)));
+	const double wl = cvRound(size.width / s), hl = cvRound(size.height / s);
+	const double ul = kp.pt.x / s, vl = kp.pt.y / s;
+	return {static_cast<float>((ul + 0.5) * size.width / wl - 0.5), static_cast<float>((vl + 0.5) * size.height / hl - 0.5)};
+}
+
 FrameFeatures FeatureExtractor::extract(const core::Frame& frame) const
 {
 	if (frame.grey.empty()) throw std::invalid_argument("FeatureExtractor: frame has no image");
@@ -146,6 +162,8 @@ FrameFeatures FeatureExtractor::extract(const core::Frame& frame) const
 	m_detector->detect(frame.grey, all);
 	f.keypoints = bucketKeypoints(all, frame.grey.size(), m_opts.gridCols, m_opts.gridRows, m_opts.numFeatures);
 	m_detector->compute(frame.grey, f.keypoints, f.descriptors);
+	// After compute(): the descriptors were taken at OpenCV's own level position
+	for (auto& kp : f.keypoints) kp.pt = levelZeroPosition(kp, frame.grey.size());
 	if (m_opts.type == "sift")
 	{
 		// Pyramid level from the keypoint scale, so matching windows work as for ORB.

@@ -37,6 +37,10 @@ struct FeatureOptions
 	/** A depth is rejected when the 3x3 neighbourhood spans more than this fraction of it,
 	 * i.e. the keypoint sits on a depth discontinuity (Default: 0.05) */
 	double maxDepthDiscontinuity{0.05};
+	/** ORB only: map keypoints found on pyramid level l to level 0 through the pyramid's pixel
+	 * centres, u0 = (u_l + 0.5) * W0 / W_l - 0.5 (W_l = the level's rounded width), instead of
+	 * OpenCV's u_l * scale^l, which is off by up to 1.3 px at level 7 (Default: true) */
+	bool pyramidPixelCentres{true};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
@@ -58,6 +62,10 @@ class FeatureExtractor
 
 	/** Depth at a raw (distorted) pixel with the validity checks of the options, 0 if invalid. */
 	float depthAt(const cv::Mat& depth, float u, float v) const;
+
+	/** Level-0 position of an ORB keypoint that OpenCV reports as pt = p_l * scale^l (see
+	 * FeatureOptions::pyramidPixelCentres); level 0 and non-ORB keypoints are returned as is. */
+	cv::Point2f levelZeroPosition(const cv::KeyPoint& kp, cv::Size imageSize) const;
 
    private:
 	FeatureOptions m_opts;
