@@ -103,6 +103,89 @@ TEST(PoseOptimizer, APointBehindTheCameraIsAnOutlierInsteadOfStoppingTheSolve)
 	EXPECT_NEAR(poseError(T, s.T_world_cam), 0.0, 1e-6);
 }
 
+namespace
+{
+// A walker: the first `moving` observations see points that moved 8 cm (world x) since their
+// landmarks were made, so the map holds them at p - 8 cm. They all agree with one wrong pose,
+// T_world_cam shifted by the same 8 cm. Observations from `anchorsFrom` on are anchors.
+Scene movingObjectScene(int n, int moving, std::vector<char>& isAnchor, int anchorsFrom)
+{
+	auto s = makeScene(n, 0.3, 0, 4);
+	isAnchor.assign(static_cast<std::size_t>(n), 0);
+	for (int i = 0; i < n; i++)
+	{
+		if (i < moving) s.obs[static_cast<std::size_t>(i)].p_world.x() -= 0.08;
+		isAnchor[static_cast<std::size_t>(i)] = i >= anchorsFrom;
+	}
+	return s;
+}
+}  // namespace
+
+TEST(PoseOptimizer, AnchoredRefinementIgnoresAMovingMajorityOfYoungLandmarks)
+{
+	// 300 matches: 180 on the walker (young), 40 young static points, 80 anchors. Both solvers
+	// start from the pose that followed the walker, as the motion model predicts it then.
+	std::vector<char> isAnchor;
+	const auto s = movingObjectScene(300, 180, isAnchor, 220);
+	const CPose3D followed = CPose3D(-0.08, 0, 0, 0, 0, 0) + s.T_world_cam;
+	CPose3D plain = followed;
+	optimizePose(plain, s.obs, K);
+	EXPECT_GT((plain - s.T_world_cam).translation().norm(), 0.07);  // the majority decides
+
+	CPose3D T = followed;
+	int rejected = -1;
+	const auto r = optimizePoseAnchored(T, s.obs, isAnchor, K, {}, 9.0, 30, &rejected);
+	EXPECT_LT((T - s.T_world_cam).translation().norm(), 2e-3);
+	EXPECT_EQ(rejected, 180);
+	for (int i = 0; i < 180; i++) EXPECT_FALSE(r.inlier[static_cast<std::size_t>(i)]) << i;
+	int youngStatic = 0;
+	for (int i = 180; i < 220; i++) youngStatic += r.inlier[static_cast<std::size_t>(i)];
+	EXPECT_GE(youngStatic, 36);  // the young static points stay (chi2 at 95 %)
+}
+
+TEST(PoseOptimizer, AnchoredRefinementEqualsThePlainOneWithoutMovingPointsOrAnchors)
+{
+	std::vector<char> isAnchor;
+	const auto s = movingObjectScene(300, 0, isAnchor, 200);
+	const CPose3D start = s.T_world_cam + CPose3D(0.02, -0.01, 0.01, 0.01, 0.02, -0.01);
+	CPose3D plain = start, anchored = start;
+	const auto rp = optimizePose(plain, s.obs, K);
+	int rejected = -1;
+	const auto ra = optimizePoseAnchored(anchored, s.obs, isAnchor, K, {}, 9.0, 30, &rejected);
+	EXPECT_EQ(rejected, 0);
+	EXPECT_EQ(ra.inliers, rp.inliers);
+	EXPECT_NEAR(poseError(anchored, plain), 0.0, 1e-4);  // the same optimum (solver paths differ)
+	// Too few anchors (100 < 150): exactly the plain refinement.
+	CPose3D few = start;
+	const auto rf = optimizePoseAnchored(few, s.obs, isAnchor, K, {}, 9.0, 150, &rejected);
+	EXPECT_EQ(rejected, 0);
+	EXPECT_EQ(rf.inlier, rp.inlier);
+	EXPECT_NEAR(poseError(few, plain), 0.0, 1e-12);
+	EXPECT_THROW(optimizePoseAnchored(few, s.obs, std::vector<char>(3, 1), K, {}, 9.0, 30), std::invalid_argument);
+}
+
+TEST(PoseOptimizer, ObservationChi2MatchesTheHandComputedResidual)
+{
+	const auto s = makeScene(1, 0.0, 0, 5);
+	auto ob = s.obs[0];
+	PoseOptimizerOptions o;
+	EXPECT_NEAR(observationChi2(s.T_world_cam, ob, K, o), 0.0, 1e-12);
+	ob.uv += Eigen::Vector2d(3.0, -4.0);  // 5 px off
+	ob.invSigma = 0.5;                    // level sigma 2 px: (5 / 2)^2
+	EXPECT_NEAR(observationChi2(s.T_world_cam, ob, K, o), 6.25, 1e-9);
+	EXPECT_DOUBLE_EQ(inlierThreshold(ob, o), o.chi2Rgbd);
+	// Depth 2 % too far: disparity error bf / d (1 - 1 / 1.02), divided by disparity_sigma.
+	ob.uv = s.obs[0].uv;
+	ob.depth = s.obs[0].depth * 1.02;
+	const double dr = (o.bf / s.obs[0].depth - o.bf / ob.depth) / o.disparitySigma;
+	EXPECT_NEAR(observationChi2(s.T_world_cam, ob, K, o), dr * dr, 1e-9);
+	ob.depth = 0;
+	EXPECT_DOUBLE_EQ(inlierThreshold(ob, o), o.chi2Mono);
+	// Behind the camera
+	ob.p_world = Eigen::Vector3d(s.T_world_cam.x(), s.T_world_cam.y(), s.T_world_cam.z()) * 2.0 - s.obs[0].p_world;
+	EXPECT_TRUE(std::isinf(observationChi2(s.T_world_cam, ob, K, o)));
+}
+
 TEST(PnpSolver, RecoversKnownPoseDespiteOutliers)
 {
 	const auto s = makeScene(150, 0.3, 40, 3);

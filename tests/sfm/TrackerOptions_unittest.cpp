@@ -7,6 +7,8 @@
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 using keygrid::sfm::requiredRelocalizationShare;
 using keygrid::sfm::TrackerOptions;
@@ -36,4 +38,24 @@ TEST(TrackerOptions, RelocalizationShareFactorIsReadAndChecked)
 	EXPECT_DOUBLE_EQ(o.relocalizationShareFactor, 0.4);
 	c.write("tracker", "relocalization_share_factor", 1.5);
 	EXPECT_THROW(o.loadFromConfigFile(c, "tracker"), std::invalid_argument);
+}
+
+TEST(TrackerOptions, AnchoredRefinementKeysAreReadAndChecked)
+{
+	mrpt::config::CConfigFileMemory c;
+	c.write("tracker", "anchor_min_keyframes", 0);
+	c.write("tracker", "anchor_chi2_factor", 4.0);
+	c.write("tracker", "anchor_min_count", 50);
+	TrackerOptions o;
+	o.loadFromConfigFile(c, "tracker");
+	EXPECT_EQ(o.anchorMinKeyFrames, 0);  // 0 = off
+	EXPECT_DOUBLE_EQ(o.anchorChi2Factor, 4.0);
+	EXPECT_EQ(o.anchorMinCount, 50);
+	for (const auto& [key, bad] : {std::pair<const char*, const char*>{"anchor_min_keyframes", "-1"}, {"anchor_chi2_factor", "0.5"}, {"anchor_min_count", "0"}})
+	{
+		mrpt::config::CConfigFileMemory b;
+		b.write("tracker", key, std::string(bad));
+		TrackerOptions t;
+		EXPECT_THROW(t.loadFromConfigFile(b, "tracker"), std::invalid_argument) << key << " = " << bad;
+	}
 }

@@ -2,7 +2,9 @@
 #include <mrpt/math/CMatrixFixed.h>
 
 #include <ceres/ceres.h>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -26,7 +28,68 @@ class AnalyticPoseCost final : public ceres::SizedCostFunction<3, 4, 3>
 	AnalyticReprojectionCost m_cost;
 	Eigen::Vector3d m_p;
 };
+// chi2 of an observation whose point is not in front of the camera (never an inlier).
+constexpr double kBehindCamera = 1e30;
+
+bool usesDepth(const PoseObservation& ob, const PoseOptimizerOptions& o) { return ob.depth > 0 && ob.depth < o.maxDepthForRgbd; }
+
+/** Squared residual of one observation at (q, t) = T_cam_world (no robust loss). */
+double chi2At(const double q[4], const double t[3], const PoseObservation& ob, const PinholeIntrinsics& K, const PoseOptimizerOptions& o)
+{
+	double u, v, ur;
+	const double p[3] = {ob.p_world.x(), ob.p_world.y(), ob.p_world.z()};
+	if (!projectRgbd(q, t, p, K, o.bf, u, v, ur)) return kBehindCamera;
+	const double du = (ob.uv.x() - u) * ob.invSigma, dv = (ob.uv.y() - v) * ob.invSigma;
+	double e = du * du + dv * dv;
+	if (usesDepth(ob, o))
+	{
+		const double dr = (o.bf / ob.depth - (u - ur)) / o.disparitySigma;  // u - ur = bf / z
+		e += dr * dr;
+	}
+	return e;
+}
 }  // namespace
+
+double inlierThreshold(const PoseObservation& ob, const PoseOptimizerOptions& o) { return usesDepth(ob, o) ? o.chi2Rgbd : o.chi2Mono; }
+
+double observationChi2(const mrpt::poses::CPose3D& T_world_cam, const PoseObservation& ob, const PinholeIntrinsics& K, const PoseOptimizerOptions& o)
+{
+	double q[4], t[3];
+	toCeres(T_world_cam, q, t);
+	const double e = chi2At(q, t, ob, K, o);
+	return e >= kBehindCamera ? std::numeric_limits<double>::infinity() : e;
+}
+
+PoseOptimizerResult optimizePoseAnchored(
+	mrpt::poses::CPose3D& T_world_cam, const std::vector<PoseObservation>& obs, const std::vector<char>& isAnchor,
+	const PinholeIntrinsics& K, const PoseOptimizerOptions& o, double chi2Factor, int minAnchors, int* rejected)
+{
+	if (isAnchor.size() != obs.size()) throw std::invalid_argument("optimizePoseAnchored: isAnchor and obs differ in size");
+	if (rejected) *rejected = 0;
+	std::vector<PoseObservation> anchors;
+	for (std::size_t i = 0; i < obs.size(); i++)
+		if (isAnchor[i]) anchors.push_back(obs[i]);
+	if (static_cast<int>(anchors.size()) < std::max(minAnchors, 3)) return optimizePose(T_world_cam, obs, K, o);
+	optimizePose(T_world_cam, anchors, K, o);
+	double q[4], t[3];
+	toCeres(T_world_cam, q, t);
+	std::vector<PoseObservation> kept;
+	std::vector<std::size_t> keptIndex;
+	for (std::size_t i = 0; i < obs.size(); i++)
+		if (isAnchor[i] || chi2At(q, t, obs[i], K, o) <= chi2Factor * inlierThreshold(obs[i], o))
+		{
+			kept.push_back(obs[i]);
+			keptIndex.push_back(i);
+		}
+	if (rejected) *rejected = static_cast<int>(obs.size() - kept.size());
+	const auto r = optimizePose(T_world_cam, kept, K, o);
+	PoseOptimizerResult res;
+	res.inlier.assign(obs.size(), 0);
+	for (std::size_t k = 0; k < kept.size(); k++) res.inlier[keptIndex[k]] = r.inlier[k];
+	res.inliers = r.inliers;
+	res.rmsPixels = r.rmsPixels;
+	return res;
+}
 
 void toCeres(const mrpt::poses::CPose3D& T_world_cam, double q[4], double t[3])
 {
@@ -73,23 +136,8 @@ PoseOptimizerResult optimizePose(
 	PoseOptimizerResult res;
 	res.inlier.assign(n, 1);
 
-	auto useDepth = [&](const PoseObservation& ob) { return ob.depth > 0 && ob.depth < o.maxDepthForRgbd; };
-	// chi2 of an observation whose point is not in front of the camera (never an inlier).
-	constexpr double kBehindCamera = 1e30;
-	// Squared residual of one observation at the current estimate (no robust loss).
-	auto chi2 = [&](const PoseObservation& ob) {
-		double u, v, ur;
-		const double p[3] = {ob.p_world.x(), ob.p_world.y(), ob.p_world.z()};
-		if (!projectRgbd(q, t, p, K, o.bf, u, v, ur)) return kBehindCamera;
-		const double du = (ob.uv.x() - u) * ob.invSigma, dv = (ob.uv.y() - v) * ob.invSigma;
-		double e = du * du + dv * dv;
-		if (useDepth(ob))
-		{
-			const double dr = (o.bf / ob.depth - (u - ur)) / o.disparitySigma;  // u - ur = bf / z
-			e += dr * dr;
-		}
-		return e;
-	};
+	auto useDepth = [&](const PoseObservation& ob) { return usesDepth(ob, o); };
+	auto chi2 = [&](const PoseObservation& ob) { return chi2At(q, t, ob, K, o); };
 
 	// A point behind the camera at the initial pose would make Ceres stop at its first
 	// evaluation: such observations start as outliers (they may come back after a round).

@@ -325,7 +325,7 @@ std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool
 	return out;
 }
 
-int Tracker::refinePose(Current& cur)
+int Tracker::refinePose(Current& cur, bool anchored)
 {
 	std::vector<PoseObservation> obs;
 	std::vector<int> kpOf;
@@ -343,7 +343,17 @@ int Tracker::refinePose(Current& cur)
 		kpOf.push_back(static_cast<int>(i));
 	}
 	if (obs.size() < 6) return 0;
-	const auto r = optimizePose(cur.T_world_cam, obs, m_K, m_opts.pose);
+	PoseOptimizerResult r;
+	if (anchored && m_opts.anchorMinKeyFrames > 0)
+	{
+		// Anchors: landmarks the map has confirmed from several keyframes (PoseOptimizer.h).
+		std::vector<char> isAnchor(obs.size(), 0);
+		for (std::size_t k = 0; k < obs.size(); k++)
+			isAnchor[k] = static_cast<int>(m_map.landmark(cur.matches[kpOf[k]]).observations.size()) >= m_opts.anchorMinKeyFrames;
+		r = optimizePoseAnchored(cur.T_world_cam, obs, isAnchor, m_K, m_opts.pose, m_opts.anchorChi2Factor, m_opts.anchorMinCount);
+	}
+	else
+		r = optimizePose(cur.T_world_cam, obs, m_K, m_opts.pose);
 	for (std::size_t k = 0; k < obs.size(); k++)
 		if (!r.inlier[k]) cur.matches[kpOf[k]] = kNoLandmark;
 	return r.inliers;
@@ -467,7 +477,7 @@ int Tracker::trackLocalMap(Current& cur, float radius)
 	cur.localMapInView = static_cast<int>(cands.size() + std::count_if(cur.matches.begin(), cur.matches.end(), [](LandmarkId l) { return l != kNoLandmark; }));
 	searchByProjection(cur.features, cands, radius, m_opts.matcher, cur.matches);
 	if (m_hoc) cur.hocVisible = cands;
-	const int inl = refinePose(cur);
+	const int inl = refinePose(cur, true);
 	for (LandmarkId l : cur.matches)
 		if (Landmark* lm = l == kNoLandmark ? nullptr : m_map.findLandmark(l)) lm->foundCount++;
 	return inl;

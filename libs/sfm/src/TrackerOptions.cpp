@@ -34,6 +34,9 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	minTrackedClose = c.read_int(s, "min_tracked_close", minTrackedClose);
 	minNewClose = c.read_int(s, "min_new_close", minNewClose);
 	minNewLandmarksPerKeyFrame = c.read_int(s, "min_new_landmarks_per_keyframe", minNewLandmarksPerKeyFrame);
+	anchorMinKeyFrames = c.read_int(s, "anchor_min_keyframes", anchorMinKeyFrames);
+	anchorChi2Factor = c.read_double(s, "anchor_chi2_factor", anchorChi2Factor);
+	anchorMinCount = c.read_int(s, "anchor_min_count", anchorMinCount);
 	matcher.maxDistanceOrb = c.read_float(s, "max_descriptor_distance_orb", matcher.maxDistanceOrb);
 	matcher.maxDistanceSift = c.read_float(s, "max_descriptor_distance_sift", matcher.maxDistanceSift);
 	matcher.ratio = c.read_float(s, "match_ratio", matcher.ratio);
@@ -57,6 +60,10 @@ void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	positive(s, "keyframe_ref_min_observations", keyFrameRefMinObservations);
 	positive(s, "pose_rounds", pose.rounds);
 	positive(s, "pose_iterations", pose.iterationsPerRound);
+	if (anchorMinKeyFrames < 0) throw std::invalid_argument("[" + s + "] anchor_min_keyframes = " + std::to_string(anchorMinKeyFrames) + " (must be >= 0; 0 = off)");
+	if (!(anchorChi2Factor >= 1))
+		throw std::invalid_argument("[" + s + "] anchor_chi2_factor = " + std::to_string(anchorChi2Factor) + " (must be >= 1)");
+	positive(s, "anchor_min_count", anchorMinCount);
 	if (relocalizationCandidates < 0 || relocalizationBowCandidates < 0)
 		throw std::invalid_argument("[" + s + "] relocalization_candidates / relocalization_bow_candidates must be >= 0");
 	if (!(relocalizationMinInlierRatio >= 0 && relocalizationMinInlierRatio <= 1))
@@ -88,6 +95,9 @@ void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "min_tracked_close", minTrackedClose, 34, 40, "");
 	c.write(s, "min_new_close", minNewClose, 34, 40, "");
 	c.write(s, "min_new_landmarks_per_keyframe", minNewLandmarksPerKeyFrame, 34, 40, "");
+	c.write(s, "anchor_min_keyframes", anchorMinKeyFrames, 34, 40, "anchored pose refinement on landmarks seen by >= this many keyframes; 0 = off");
+	c.write(s, "anchor_chi2_factor", anchorChi2Factor, 34, 40, "drop younger matches above this x the chi-square threshold at the anchored pose");
+	c.write(s, "anchor_min_count", anchorMinCount, 34, 40, "anchors needed for the anchored refinement");
 	c.write(s, "max_descriptor_distance_orb", matcher.maxDistanceOrb, 34, 40, "Hamming bits");
 	c.write(s, "max_descriptor_distance_sift", matcher.maxDistanceSift, 34, 40, "L2");
 	c.write(s, "match_ratio", matcher.ratio, 34, 40, "best/second-best");

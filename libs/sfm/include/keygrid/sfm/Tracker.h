@@ -118,8 +118,10 @@ class Tracker
 	bool relocalize(Current& cur);
 	/** Projects the local map's unmatched landmarks, matches, refines; returns inliers. */
 	int trackLocalMap(Current& cur, float radius);
-	/** Refines cur.T_world_cam from cur.matches; drops outlier matches; returns inliers. */
-	int refinePose(Current& cur);
+	/** Refines cur.T_world_cam from cur.matches; drops outlier matches; returns inliers.
+	 * `anchored`: the final refinement against the local map, anchored on the landmarks seen by
+	 * >= anchor_min_keyframes keyframes (optimizePoseAnchored). */
+	int refinePose(Current& cur, bool anchored = false);
 	void updateLocalKeyFrames(const Current& cur);
 	/** Local-map landmarks in view of cur's pose, not yet matched and (with HOC) selected for
 	 * this camera; with `forLocalMap` they are counted as visible and the HOC lists of cur are

@@ -73,6 +73,18 @@ struct TrackerOptions
 	 * set the value calibrated on TUM fr1, doc/frontend.md "Rolling shutter") */
 	double rollingShutterReadout{0.0};
 
+	/** Anchored pose refinement against moving objects (optimizePoseAnchored, PoseOptimizer.h):
+	 * the final refinement of each frame is solved first from the landmarks seen by at least
+	 * this many keyframes, and matches of younger landmarks whose chi-square there exceeds
+	 * anchor_chi2_factor x the inlier threshold are dropped. 0 = off (Default: 3; people
+	 * walking past a moving camera, keygrid-sim moving_camera_dynamic: 256 -> 17 mm ATE, fr1_rpy
+	 * +2 %, doc/evaluation.md) */
+	int anchorMinKeyFrames{3};
+	/** Rejection threshold of that test, a multiple of the chi-square inlier threshold
+	 * (Default: 9, i.e. 3x the residual) */
+	double anchorChi2Factor{9.0};
+	/** Anchored refinement only with at least this many anchors matched (Default: 30) */
+	int anchorMinCount{30};
 	MatcherOptions matcher;
 	PoseOptimizerOptions pose;
 	PnpOptions pnp;
