@@ -28,6 +28,7 @@ class AnalyticPoseCost final : public ceres::SizedCostFunction<3, 4, 3>
 	AnalyticReprojectionCost m_cost;
 	Eigen::Vector3d m_p;
 };
+
 // chi2 of an observation whose point is not in front of the camera (never an inlier).
 constexpr double kBehindCamera = 1e30;
 
