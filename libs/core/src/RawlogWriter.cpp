@@ -1,5 +1,6 @@
 #include <keygrid/core/RawlogWriter.h>
 #include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
@@ -12,7 +13,13 @@ namespace keygrid::core
 {
 struct RawlogWriter::Impl
 {
+	/** The last serialized observation. It must outlive `out`: when a write fails (disk full),
+	 * zlib keeps pointing at the input it could not compress, and gzclose() compresses it
+	 * again. Written from the observation's own image buffers, that read freed memory once the
+	 * caller had dropped the observation (found by AddressSanitizer with a full disk). */
+	mrpt::io::CMemoryStream chunk;
 	mrpt::io::CFileGZOutputStream out;
+	bool failed{false};
 };
 
 RawlogWriter::RawlogWriter(const std::string& path, const RawlogWriterOptions& opts)
@@ -52,13 +59,23 @@ void RawlogWriter::write(const mrpt::obs::CObservation::Ptr& obs)
 				throw std::runtime_error("cannot write '" + full + "'");
 			o->intensityImage.setExternalStorage(name);  // relative to the images dir
 		}
-	auto arch = mrpt::serialization::archiveFrom(m_impl->out);
+	// After a failed write zlib refers to `chunk` until close(): it must not change any more.
+	if (m_impl->failed) throw std::runtime_error("cannot write '" + m_tmpPath + "' (an earlier write failed)");
+	m_impl->chunk.clear();
+	auto arch = mrpt::serialization::archiveFrom(m_impl->chunk);
 	arch << *obs;
+	const auto n = static_cast<size_t>(m_impl->chunk.getTotalBytesCount());
+	if (m_impl->out.Write(m_impl->chunk.getRawBufferData(), n) != n)
+	{
+		m_impl->failed = true;
+		throw std::runtime_error("cannot write '" + m_tmpPath + "' (disk full?)");
+	}
 	++m_count;
 }
 
 void RawlogWriter::close()
 {
+	if (m_impl->failed) throw std::runtime_error("cannot write '" + m_tmpPath + "' (an earlier write failed)");
 	m_impl->out.close();
 	if (std::rename(m_tmpPath.c_str(), m_path.c_str()) != 0)
 		throw std::runtime_error("cannot rename '" + m_tmpPath + "' to '" + m_path + "'");
