@@ -2,7 +2,8 @@
 /** \file RawlogWriter.h
  * Writes observations to an MRPT rawlog (observation-only format), atomically: the data go to
  * `<path>.tmp` and are renamed to `<path>` by close(), so a crash never leaves a half file
- * under the final name.
+ * under the final name. A failed write (disk full) throws std::runtime_error naming the temp
+ * file; after it write() and close() throw too, and the destructor removes the temp file.
  */
 #include <mrpt/obs/CObservation.h>
 
@@ -26,7 +27,8 @@ class RawlogWriter
 	RawlogWriter(const std::string& path, const RawlogWriterOptions& opts = {});
 	~RawlogWriter();  //!< discards the temp file if close() was not called
 
-	/** Appends one observation (its intensity image is externalised when so configured). */
+	/** Appends one observation (its intensity image is externalised when so configured).
+	 * Throws std::runtime_error when the data cannot be written. */
 	void write(const mrpt::obs::CObservation::Ptr& obs);
 	/** Flushes and renames the temp file into place. Throws on I/O failure. */
 	void close();
