@@ -311,7 +311,7 @@ void System::finish()
 			const auto& f = m_frames[i];
 			if (!f.tracked) continue;
 			// A keyframe keeps its pose from the (global) bundle adjustment: that joint estimate
-			// beats a pose-only one against points it helped place (measured in doc/evaluation.md).
+			// beats a pose-only one against points it helped place (measured in doc/evaluation-history.md).
 			if (f.newKeyFrame && map.hasKeyFrame(f.keyframe)) continue;
 			std::vector<sfm::PoseObservation> obs;
 			for (std::size_t k = 0; k < f.observations.size(); k++)

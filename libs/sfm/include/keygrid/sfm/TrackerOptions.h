@@ -56,7 +56,7 @@ struct TrackerOptions
 	double keyFrameTrackedRatio{0.5};
 	/** Reference-keyframe landmarks counted by that ratio: those seen by at least this many
 	 * keyframes (Default: 1, all of them. ORB-SLAM2's RGB-D rule, 2 with ratio 0.75, gave
-	 * fewer keyframes and 2-3x the error on the synthetic room loops: doc/evaluation.md) */
+	 * fewer keyframes and 2-3x the error on the synthetic room loops: doc/evaluation-history.md) */
 	int keyFrameRefMinObservations{1};
 	/** Depth under which points count as "close" (well-measured) [m] (Default: 3.0) */
 	double closeDepth{3.0};
