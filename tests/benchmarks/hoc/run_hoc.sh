@@ -16,16 +16,9 @@ BIN="$BUILD/bin"
 DATA="${KEYGRID_SHARED_DATA:-$SRC/../shared/data}"
 mkdir -p "$OUT"
 
-# Configurations: config/sim.ini without its maps (they do not change the trajectory) and
-# config/tum_fr1.ini, each with [hoc] enabled = false / true.
-sed '/^\[MappingApplication/,$d' "$SRC/config/sim.ini" > "$OUT/sim_std.ini"
-cp "$OUT/sim_std.ini" "$OUT/sim_hoc.ini"
-cp "$SRC/config/tum_fr1.ini" "$OUT/fr1_std.ini"
-cp "$SRC/config/tum_fr1.ini" "$OUT/fr1_hoc.ini"
-for f in sim fr1; do
-	printf '\n[hoc]\nenabled = false\n' >> "$OUT/${f}_std.ini"
-	printf '\n[hoc]\nenabled = true\n' >> "$OUT/${f}_hoc.ini"
-done
+# Configurations: sim_std.ini / sim_hoc.ini, fr1_std.ini / fr1_hoc.ini (hoc_configs.sh).
+source "$SRC/tests/benchmarks/hoc/hoc_configs.sh"
+write_hoc_configs "$SRC" "$OUT"
 
 generate() {  # scene [seed]
 	local dir="$OUT/seq_$1"
