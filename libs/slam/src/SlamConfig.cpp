@@ -47,7 +47,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	tracker.hoc.saveToConfigFile(c, "hoc");
 	mapping.saveToConfigFile(c, "mapping");
 	c.write("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment, 30, 40, "bundle-adjust everything after the last frame");
-	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "");
+	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "upper bound on its iterations (it stops on convergence)");
 	maps.saveToConfigFile(c, "maps");
 	loop.saveToConfigFile(c, "loop_closing");
 	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame that is not a keyframe against the final map");
