@@ -34,23 +34,24 @@ run() {  # name input gt cfgprefix
 	done
 }
 
-online_te() {  # gt run_dir -> ATE of trajectory_online.txt [mm], or n/a
-	"$BIN/keygrid-eval" --gt "$1" --est "$2/trajectory_online.txt" --json "$2/online_eval.json" > /dev/null 2>&1 &&
-		/usr/bin/python3 -c 'import json, sys; print("%.1f" % (1000 * json.load(open(sys.argv[1]))["ate_rmse_m"]))' "$2/online_eval.json" ||
-		echo "n/a"
-}
-
 declare -a ROWS=()
 row() {  # name label share gt
-	local line online
-	online="$(online_te "$4" "$OUT/$1_std") / $(online_te "$4" "$OUT/$1_hoc")"
-	line=$(/usr/bin/python3 - "$OUT/$1_std/report.json" "$OUT/$1_hoc/report.json" "$2" "$3" "$online" <<'PY'
-import json, sys
-s, h = (json.load(open(p)) for p in sys.argv[1:3])
+	local line v
+	# the online trajectory's ATE -> RUN/online_eval.json (left missing when it cannot be scored)
+	for v in std hoc; do
+		rm -f "$OUT/$1_$v/online_eval.json"
+		"$BIN/keygrid-eval" --gt "$4" --est "$OUT/$1_$v/trajectory_online.txt" --json "$OUT/$1_$v/online_eval.json" > /dev/null 2>&1 || true
+	done
+	line=$(/usr/bin/python3 - "$OUT/$1_std" "$OUT/$1_hoc" "$2" "$3" <<'PY'
+import json, os, sys
+s, h = (json.load(open(os.path.join(d, "report.json"))) for d in sys.argv[1:3])
+def online(d):
+    p = os.path.join(d, "online_eval.json")
+    return "%.1f" % (1000 * json.load(open(p))["ate_rmse_m"]) if os.path.exists(p) else "n/a"
 def te(r): return "%.1f" % (1000 * r["ate_rmse_m"]) if r.get("ate_rmse_m") is not None else "n/a"
 def re_(r): return "%.3f" % r["ate_rot_rmse_deg"] if r.get("ate_rot_rmse_deg") is not None else "n/a"
 hoc = h["timings"].get("hoc", {})
-print("| %s | %s | %s | %s | %s | %s | %s | %s | %d | %d | %d/%d | %s / %s |" % (sys.argv[3], sys.argv[4], te(s), te(h), sys.argv[5], re_(s), re_(h),
+print("| %s | %s | %s | %s | %s | %s | %s | %s | %d | %d | %d/%d | %s / %s |" % (sys.argv[3], sys.argv[4], te(s), te(h), online(sys.argv[1]) + " / " + online(sys.argv[2]), re_(s), re_(h),
       "%.1fx" % (s["landmarks"] / max(1, h["landmarks"])), s["landmarks"], h["landmarks"], s["tracked"], h["tracked"],
       hoc.get("median_ms", "n/a"), hoc.get("p95_ms", "n/a")))
 PY

@@ -8,7 +8,7 @@ def sec(name, **kv):
     for k, v in kv.items(): out.append('%s = %s' % (k, v))
     out.append('')
 def f(*a): return ' '.join('%g' % round(x, 3) for x in a)
-def strip(prefix, x0, y0, dx, dy, n_along, along_x, texture, colour, z):
+def strip(prefix, x0, y0, dx, dy, along_x, texture, colour, z):
     # tiles of <= 2 m along the strip
     L = dx if along_x else dy
     k, s = 0, 0.0
@@ -25,10 +25,10 @@ def wall(prefix, x0, y0, x1, y1, colour):
         sec('%s_%02d' % (prefix, k), type='quad', corner=f(x0 + ux * s, y0 + uy * s, 0), edge1=f(ux * l, uy * l, 0), edge2=f(0, 0, Z), colour=colour)
         k += 1; s += l
 for name, z, tex, col in (('floor', 0.0, 'checker', '160 150 130'), ('ceiling', Z, 'blobs', '205 205 195')):
-    strip(name + '_s', 0, 0, W, C, 0, True, tex, col, z)
-    strip(name + '_n', 0, H - C, W, C, 0, True, tex, col, z)
-    strip(name + '_w', 0, C, C, H - 2 * C, 0, False, tex, col, z)
-    strip(name + '_e', W - C, C, C, H - 2 * C, 0, False, tex, col, z)
+    strip(name + '_s', 0, 0, W, C, True, tex, col, z)
+    strip(name + '_n', 0, H - C, W, C, True, tex, col, z)
+    strip(name + '_w', 0, C, C, H - 2 * C, False, tex, col, z)
+    strip(name + '_e', W - C, C, C, H - 2 * C, False, tex, col, z)
 wall('wall_out_s', 0, 0, W, 0, '190 170 140')
 wall('wall_out_e', W, 0, W, H, '200 160 160')
 wall('wall_out_n', W, H, 0, H, '140 170 190')

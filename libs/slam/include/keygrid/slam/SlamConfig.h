@@ -24,7 +24,7 @@ struct RefinementOptions
 	bool globalBundleAdjustment{true};
 	/** Upper bound on the Levenberg-Marquardt iterations of the final global bundle adjustment,
 	 * which otherwise stops when an iteration lowers the cost by less than 1e-6 (Default: 100).
-	 * The synthetic room and corridor loops converge in 2-9 iterations, fr1_rpy in 6; the 44 m
+	 * The synthetic room and corridor loops converge in 2-9 iterations, fr1_rpy in 6-52; the 44 m
 	 * office_loop needs 46-47, and the former bound of 20 left its loop-closed trajectory at
 	 * 1.44 instead of 1.11 cm (doc/evaluation.md, "Batch"). */
 	int globalIterations{100};
