@@ -63,6 +63,23 @@ TEST(CISMOccupancyGrid2D_io, SerializationRoundTrip)
 	ASSERT_EQ(b->keyframes().size(), a.keyframes().size());
 	EXPECT_EQ(b->keyframes().at(3).points_cam.size(), a.keyframes().at(3).points_cam.size());
 	EXPECT_EQ(b->keyframes().at(3).points_cam[7].x, a.keyframes().at(3).points_cam[7].x);
+	EXPECT_EQ(b->insertionOptions.freeSpaceModel, CISMOccupancyGrid2D::FreeSpaceModel::HeightBand);
+	EXPECT_DOUBLE_EQ(b->insertionOptions.bandSliceHeight, a.insertionOptions.bandSliceHeight);
+	// The height slices came along: one more keyframe gives the same grid in both.
+	keygrid::test::SyntheticRoom room;
+	std::mt19937 rng(9);
+	const auto T = room.cameraPose(-0.5, 0.3, 1.0, 2.0, 0.3);
+	const auto pts = room.samplePoints(T, 300, 0.01, rng);
+	a.insertKeyframePoints(100, T, pts);
+	b->insertKeyframePoints(100, T, pts);
+	size_t changed = 0;
+	for (int cy = 0; cy < a.sizeY(); cy++)
+		for (int cx = 0; cx < a.sizeX(); cx++)
+		{
+			ASSERT_EQ(b->logOdds(cx, cy), a.logOdds(cx, cy)) << "cell " << cx << "," << cy;
+			changed += a.logOdds(cx, cy) != 0.0f;
+		}
+	EXPECT_GT(changed, 100u);
 }
 
 TEST(CISMOccupancyGrid2D_io, UnknownSerializationVersionThrows)

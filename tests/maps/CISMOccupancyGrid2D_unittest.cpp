@@ -26,12 +26,19 @@ namespace
 mrpt::poses::CPose3D levelCamera() { return keygrid::test::SyntheticRoom().cameraPose(0.025, 0.025, 0.5, 0.0, 0.0); }
 }  // namespace
 
+/* A level ray at 0.5 m to an obstacle 1 m ahead. Paper model: each cell on it follows the
+ * closed-form ISM update. Height band: the ray stays in one height slice, which follows the same
+ * update; the column shows it where it is positive (obstacle evidence) and is unknown elsewhere,
+ * since the ray never came below obstacleMinHeight to see the ground clear. */
 TEST(CISMOccupancyGrid2D, LogOddsUpdateFollowsClosedFormIsmAndClamps)
 {
+	using Model = CISMOccupancyGrid2D::FreeSpaceModel;
+	for (auto model : {Model::Paper, Model::HeightBand})
 	for (auto trav : {CISMOccupancyGrid2D::RayTraversal::Bresenham, CISMOccupancyGrid2D::RayTraversal::AntiAliased})
 	{
 		CISMOccupancyGrid2D grid;  // 5 cm, -5..5 m
 		auto& o = grid.insertionOptions;
+		o.freeSpaceModel = model;
 		o.rangeNoise = keygrid::maps::RangeNoiseModel::Constant;
 		o.sigmaConstant = 0.02;
 		o.rayTraversal = trav;
@@ -52,15 +59,16 @@ TEST(CISMOccupancyGrid2D, LogOddsUpdateFollowsClosedFormIsmAndClamps)
 				double inc = keygrid::maps::logit(keygrid::maps::practicalIsm(r, z, 0.02, shape));
 				if (r > z + 0.5 * shape.bandWidth + 8 * 0.02) inc = 0;  // beyond the traced reach
 				expected[static_cast<size_t>(i)] = std::clamp(expected[static_cast<size_t>(i)] + inc, o.logOddsMin, o.logOddsMax);
-				ASSERT_NEAR(grid.logOdds(c0 + i, cy), expected[static_cast<size_t>(i)], 2e-5)
+				const double column = model == Model::Paper ? expected[static_cast<size_t>(i)] : std::max(0.0, expected[static_cast<size_t>(i)]);
+				ASSERT_NEAR(grid.logOdds(c0 + i, cy), column, 2e-5)
 					<< "insertion " << k << " cell " << i << " (r=" << r << ")";
 			}
 		}
 		// Saturated: the endpoint cell at the clamp maximum, cells before it at the minimum.
 		EXPECT_NEAR(grid.logOdds(c0 + 20, cy), o.logOddsMax, 1e-6);
-		EXPECT_NEAR(grid.logOdds(c0 + 10, cy), o.logOddsMin, 1e-6);
+		EXPECT_NEAR(grid.logOdds(c0 + 10, cy), model == Model::Paper ? o.logOddsMin : 0.0, 1e-6);
 		EXPECT_EQ(grid.cellState(c0 + 20, cy), CellState::Occupied);
-		EXPECT_EQ(grid.cellState(c0 + 10, cy), CellState::Free);
+		EXPECT_EQ(grid.cellState(c0 + 10, cy), model == Model::Paper ? CellState::Free : CellState::Unknown);
 		EXPECT_EQ(grid.cellState(c0 + 30, cy), CellState::Unknown);
 		// Cells off the ray are untouched.
 		EXPECT_EQ(grid.logOdds(c0 + 10, cy + 3), 0.0f);
@@ -79,10 +87,19 @@ TEST(CISMOccupancyGrid2D, HeightBandSelectsObstacles)
 	const double nan = std::numeric_limits<double>::quiet_NaN();
 	grid.insertKeyframePoints(9, levelCamera(), {TPoint3D(nan, 0.025, 1.0), TPoint3D(1.0, nan, 1.0)});
 	EXPECT_TRUE(grid.isEmpty());
-	// A floor point only clears: free up to it, nothing occupied.
+	// A floor point only clears, nothing occupied; height band (the default): only the cells
+	// where the ray from the camera at 0.5 m is below obstacleMinHeight = 0.1 m (the last 0.2 m).
 	grid.insertKeyframePoints(2, levelCamera(), {TPoint3D(1.025, 0.025, 0.0)});
-	EXPECT_EQ(grid.cellState(grid.x2idx(0.5), cy), CellState::Free);
+	EXPECT_EQ(grid.cellState(grid.x2idx(0.5), cy), CellState::Unknown);
+	EXPECT_EQ(grid.cellState(grid.x2idx(0.725), cy), CellState::Unknown);
+	EXPECT_EQ(grid.cellState(grid.x2idx(0.875), cy), CellState::Free);
+	EXPECT_EQ(grid.cellState(grid.x2idx(1.025), cy), CellState::Free);
 	EXPECT_EQ(grid.countStates()[2], 0u);
+	// The paper's model frees the whole ray.
+	CISMOccupancyGrid2D paper;
+	paper.insertionOptions.freeSpaceModel = CISMOccupancyGrid2D::FreeSpaceModel::Paper;
+	paper.insertKeyframePoints(2, levelCamera(), {TPoint3D(1.025, 0.025, 0.0)});
+	EXPECT_EQ(paper.cellState(paper.x2idx(0.5), cy), CellState::Free);
 	// An obstacle in the band is occupied.
 	grid.insertKeyframePoints(3, levelCamera(), {TPoint3D(1.025, 0.025, 1.2)});
 	EXPECT_EQ(grid.cellState(grid.x2idx(1.025), cy), CellState::Occupied);

@@ -22,6 +22,13 @@ struct SyntheticRoom
 {
 	double hx{2.025}, hy{1.525}, height{2.5};
 	mrpt::poses::CPose3D T_world_level;  ///< the room's level frame in the world
+	/** Solid axis-aligned boxes in the level frame (furniture: a table top, its legs, a crate). */
+	struct Box
+	{
+		mrpt::math::TPoint3D lo, hi;
+		bool containsXY(double x, double y) const { return x >= lo.x && x <= hi.x && y >= lo.y && y <= hi.y; }
+	};
+	std::vector<Box> boxes;
 
 	/** Optical camera at (x, y, h) in the level frame, yaw theta, pitched down by `pitch`. */
 	mrpt::poses::CPose3D cameraPose(double x, double y, double h, double yaw, double pitch) const
@@ -63,6 +70,26 @@ struct SyntheticRoom
 		plane(o.y, d.y, -hy);
 		plane(o.z, d.z, 0.0);
 		plane(o.z, d.z, height);
+		for (const Box& b : boxes)
+		{
+			// Slab test: the entry parameter of the ray into the box, if it enters in front.
+			double t0 = 0, t1 = std::numeric_limits<double>::max();
+			for (int i = 0; i < 3; i++)
+			{
+				const double oi = i == 0 ? o.x : i == 1 ? o.y : o.z, di = d[i];
+				const double lo = i == 0 ? b.lo.x : i == 1 ? b.lo.y : b.lo.z, hi = i == 0 ? b.hi.x : i == 1 ? b.hi.y : b.hi.z;
+				if (std::abs(di) < 1e-12)
+				{
+					if (oi < lo || oi > hi) t0 = t1 + 1;
+					continue;
+				}
+				double ta = (lo - oi) / di, tb = (hi - oi) / di;
+				if (ta > tb) std::swap(ta, tb);
+				t0 = std::max(t0, ta);
+				t1 = std::min(t1, tb);
+			}
+			if (t0 <= t1 && t0 > 1e-9 && t0 < best) best = t0;
+		}
 		return best <= maxDepth ? best : 0.0;  // d has unit optical z: t is the depth
 	}
 

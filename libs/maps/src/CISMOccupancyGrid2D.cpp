@@ -63,6 +63,33 @@ void CISMOccupancyGrid2D::resetGeometry(const TCreationOptions& c)
 	m_logOdds.assign(static_cast<size_t>(m_sizeX) * m_sizeY, 0.0f);
 	m_scratch.assign(m_logOdds.size(), 0.0f);
 	m_touched.clear();
+	m_band.clear();
+	m_bandScratch.clear();
+	m_bandTouched.clear();
+	m_bandSlices = 0;
+}
+
+int CISMOccupancyGrid2D::bandSlicesWanted() const
+{
+	const auto& o = insertionOptions;
+	return std::max(1, static_cast<int>(std::ceil((o.obstacleMaxHeight - o.obstacleMinHeight) / o.bandSliceHeight - 1e-9)));
+}
+
+void CISMOccupancyGrid2D::resetBand()
+{
+	m_bandSlices = bandSlicesWanted();
+	const size_t n = m_logOdds.size() * static_cast<size_t>(m_bandSlices + 1);
+	m_band.assign(n, 0.0f);
+	m_bandScratch.assign(n, 0.0f);
+	m_bandTouched.clear();
+}
+
+float CISMOccupancyGrid2D::columnLogOdds(size_t cell) const
+{
+	const size_t stride = static_cast<size_t>(m_bandSlices + 1);
+	const float* v = &m_band[cell * stride];
+	const float strongest = *std::max_element(v + 1, v + stride);
+	return strongest > 0.0f ? strongest : v[0];
 }
 
 void CISMOccupancyGrid2D::internal_clear()
@@ -94,6 +121,18 @@ void CISMOccupancyGrid2D::growToContain(double x0, double x1, double y0, double 
 		std::copy_n(&m_logOdds[static_cast<size_t>(cy) * m_sizeX], m_sizeX,
 			&grown[static_cast<size_t>(cy + addBottom) * nx + addLeft]);
 	m_logOdds.swap(grown);
+	if (!m_band.empty())
+	{
+		// The band values move with their cells: same copy, bandStride values per cell.
+		const size_t stride = static_cast<size_t>(m_bandSlices + 1);
+		std::vector<float> band(static_cast<size_t>(nx) * ny * stride, 0.0f);
+		for (int cy = 0; cy < m_sizeY; cy++)
+			std::copy_n(&m_band[static_cast<size_t>(cy) * m_sizeX * stride], static_cast<size_t>(m_sizeX) * stride,
+				&band[(static_cast<size_t>(cy + addBottom) * nx + addLeft) * stride]);
+		m_band.swap(band);
+		m_bandScratch.assign(m_band.size(), 0.0f);
+		m_bandTouched.clear();
+	}
 	m_xMin -= addLeft * m_resolution;
 	m_yMin -= addBottom * m_resolution;
 	m_sizeX = nx;

@@ -82,22 +82,31 @@ std::vector<TPoint3Df> keygrid::depthToCameraPoints(
 void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::vector<TPoint3Df>& pts)
 {
 	const TInsertionOptions& o = insertionOptions;
+	const bool band = heightBand();
+	if (band && (m_bandSlices != bandSlicesWanted() || m_band.size() != m_logOdds.size() * static_cast<size_t>(m_bandSlices + 1)))
+		resetBand();
 	const maps::IsmShape shape = o.ismShape(m_resolution);
 	const double l0 = maps::logit(o.pPrior);
 	const float lFree = static_cast<float>(maps::logit(o.pFree) - l0);
 	const CPose3D T_floor_cam = T_world_cam - floorPose();  // a - b = inv(b) (+) a
 	const RigidF T(T_floor_cam);
-	const float sx = T.t[0], sy = T.t[1];
+	const float sx = T.t[0], sy = T.t[1], sz = T.t[2];
 	const double halfL = 0.5 * shape.bandWidth;
 	const float maxRange2 = static_cast<float>(o.maxRange * o.maxRange);
+	const float hMin = static_cast<float>(o.obstacleMinHeight), hMax = static_cast<float>(o.obstacleMaxHeight);
+	const float fTol = static_cast<float>(o.floorTolerance);
+	const float sliceH = static_cast<float>(o.bandSliceHeight);
+	auto sliceOf = [&](float z) { return std::clamp(static_cast<int>(std::floor((z - hMin) / sliceH)), 0, m_bandSlices - 1); };
 
 	// 1) classify and collect the rays in the floor frame, with their bounding box.
 	struct Ray
 	{
-		float ex, ey;  // endpoint footprint (floor frame) [m]
+		float ex, ey, ez;  // endpoint (floor frame) [m]
 		float range;  // horizontal camera -> endpoint distance [m]
 		float sigma;  // range noise [m]
 		bool obstacle;
+		uint64_t slices;  // heightBand: band slices with obstacle points in the endpoint cell
+		int cell;  // heightBand: endpoint cell (for grouping), -1 outside the grid
 	};
 	std::vector<Ray> rays;
 	rays.reserve(pts.size());
@@ -106,8 +115,8 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 	{
 		float fx, fy, fz;
 		T.apply(p.x, p.y, p.z, fx, fy, fz);
-		const bool obstacle = fz >= o.obstacleMinHeight && fz <= o.obstacleMaxHeight;
-		const bool floor = std::abs(fz) <= o.floorTolerance;
+		const bool obstacle = fz >= hMin && fz <= hMax;
+		const bool floor = std::abs(fz) <= fTol;
 		if (!obstacle && !floor) continue;
 		const float dx = fx - sx, dy = fy - sy;
 		const float d2 = dx * dx + dy * dy;
@@ -115,10 +124,13 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 		Ray r;
 		r.ex = fx;
 		r.ey = fy;
+		r.ez = fz;
 		r.range = std::sqrt(d2);
 		// Depth along the optical axis drives the noise; the ray is (nearly) horizontal.
 		r.sigma = static_cast<float>(maps::rangeSigma(o.rangeNoise, o.sigmaConstant, p.z));
 		r.obstacle = obstacle;
+		r.slices = 0;
+		r.cell = -1;
 		// Obstacle rays continue behind the endpoint while the ISM differs from the prior.
 		const double reach = obstacle ? r.range + halfL + 8.0 * r.sigma : r.range;
 		const double ux = sx + dx / r.range * reach, uy = sy + dy / r.range * reach;
@@ -131,7 +143,35 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 	if (rays.empty()) return;
 	growToContain(bx0 - m_resolution, bx1 + m_resolution, by0 - m_resolution, by1 + m_resolution);
 
-	// 2) trace: every visited cell gets one combined increment in m_scratch.
+	if (band)
+	{
+		// One obstacle ray per endpoint cell, to its nearest point; the cell's other points only
+		// add their height slices to the occupied end of that ray (their free parts would mostly
+		// repeat it, at a multiple of the cost).
+		for (Ray& r : rays)
+		{
+			r.cell = inside(x2idx(r.ex), y2idx(r.ey)) ? x2idx(r.ex) + y2idx(r.ey) * m_sizeX : -1;
+			if (r.obstacle) r.slices = uint64_t{1} << sliceOf(r.ez);
+		}
+		std::sort(rays.begin(), rays.end(), [](const Ray& a, const Ray& b) {
+			if (a.obstacle != b.obstacle) return a.obstacle;
+			if (a.cell != b.cell) return a.cell < b.cell;
+			return a.range < b.range;
+		});
+		size_t keep = 0;
+		for (size_t i = 0; i < rays.size(); i++)
+		{
+			if (rays[i].obstacle && keep > 0 && rays[keep - 1].obstacle && rays[keep - 1].cell == rays[i].cell && rays[i].cell >= 0)
+			{
+				rays[keep - 1].slices |= rays[i].slices;
+				continue;
+			}
+			rays[keep++] = rays[i];
+		}
+		rays.resize(keep);
+	}
+
+	// 2) trace: every visited cell (heightBand: every visited slice) gets one combined increment.
 	const double res = m_resolution;
 	auto toCellX = [&](double x) { return (x - m_xMin) / res - 0.5; };  // cell centre at integer
 	auto toCellY = [&](double y) { return (y - m_yMin) / res - 0.5; };
@@ -148,6 +188,34 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 		else
 			s = combine(s, inc);
 	};
+	const size_t stride = static_cast<size_t>(m_bandSlices + 1);
+	auto touchSlot = [&](size_t idx, float inc) {
+		float& s = m_bandScratch[idx];
+		if (s == 0.0f)
+		{
+			m_bandTouched.push_back(idx);
+			s = inc;
+		}
+		else
+			s = combine(s, inc);
+	};
+	/* heightBand: the ray crosses the column of a cell between heights za and zb. A free
+	 * increment goes to the slices of [za, zb] in the band and, when the ray is below
+	 * obstacleMinHeight there, to the cell's ground clearance; an occupied increment to those
+	 * slices and to the slices of the ray's endpoint cell (`extra`). */
+	auto touchBand = [&](int cx, int cy, float za, float zb, float inc, uint64_t extra) {
+		if (!inside(cx, cy) || inc == 0.0f) return;
+		if (za > zb) std::swap(za, zb);
+		const size_t base = (static_cast<size_t>(cx) + static_cast<size_t>(cy) * m_sizeX) * stride;
+		if (inc < 0.0f && za < hMin && zb >= -fTol) touchSlot(base, inc);
+		if (zb >= hMin && za <= hMax)
+		{
+			const int k1 = sliceOf(zb);
+			for (int k = sliceOf(za); k <= k1; k++) touchSlot(base + 1 + static_cast<size_t>(k), inc);
+		}
+		if (inc > 0.0f)
+			for (uint64_t m = extra; m; m &= m - 1) touchSlot(base + 1 + static_cast<size_t>(__builtin_ctzll(m)), inc);
+	};
 	// Log-odds increment of the practical ISM at distance r; exact-free / prior far from the band.
 	auto ismIncrement = [&](double r, const Ray& ray) -> float {
 		if (!ray.obstacle) return r <= ray.range ? lFree : 0.0f;
@@ -162,6 +230,21 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 		const double reach = ray.obstacle ? ray.range + halfL + 8.0 * ray.sigma : ray.range;
 		const double k = reach / ray.range;
 		const double ex = sx + (ray.ex - sx) * k, ey = sy + (ray.ey - sy) * k;
+		// heightBand: height of the ray at horizontal distance r, and the half length of the
+		// ray's chord through one cell column (one step of the major axis).
+		const double slope = (ray.ez - sz) / ray.range;
+		const double ux = std::abs(ray.ex - sx) / ray.range, uy = std::abs(ray.ey - sy) / ray.range;
+		const double halfChord = 0.5 * res / std::max(ux, uy);
+		const double rEnd = ray.obstacle ? reach : ray.range;
+		auto visit = [&](int cx, int cy, double r, float inc) {
+			if (!band)
+			{
+				touch(cx, cy, inc);
+				return;
+			}
+			const double ra = std::max(0.0, r - halfChord), rb = std::min(rEnd, r + halfChord);
+			touchBand(cx, cy, static_cast<float>(sz + slope * ra), static_cast<float>(sz + slope * rb), inc, ray.slices);
+		};
 		if (o.rayTraversal == RayTraversal::Bresenham)
 		{
 			const int c0x = static_cast<int>(std::lround(csx)), c0y = static_cast<int>(std::lround(csy));
@@ -170,20 +253,42 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 			maps::bresenhamLine(c0x, c0y, c1x, c1y, [&](int cx, int cy) {
 				const double dx = idx2x(cx) - sx, dy = idx2y(cy) - sy;
 				const double r = std::sqrt(dx * dx + dy * dy);
-				touch(cx, cy, ismIncrement(r, ray));
+				visit(cx, cy, r, ismIncrement(r, ray));
 			});
 		}
 		else
 		{
 			maps::wuLine(csx, csy, toCellX(ex), toCellY(ey), [&](int cx, int cy, float w, double px, double py) {
 				const double r = res * std::sqrt((px - csx) * (px - csx) + (py - csy) * (py - csy));
-				touch(cx, cy, w * ismIncrement(r, ray));
+				visit(cx, cy, r, w * ismIncrement(r, ray));
 			});
 		}
 	}
 
-	// 3) apply l_t = l_{t-1} + ISM - l0 once per touched cell, clamped.
+	// 3) apply l_t = l_{t-1} + ISM - l0 once per touched cell (heightBand: slice), clamped.
 	const float lo = static_cast<float>(o.logOddsMin - l0), hi = static_cast<float>(o.logOddsMax - l0);
+	if (band)
+	{
+		for (size_t idx : m_bandTouched)
+		{
+			m_band[idx] = std::clamp(m_band[idx] + m_bandScratch[idx], lo, hi);
+			m_bandScratch[idx] = 0.0f;
+			const size_t cell = idx / stride;
+			if (m_scratch[cell] == 0.0f)
+			{
+				m_scratch[cell] = 1.0f;  // marks the cell for the column update below
+				m_touched.push_back(static_cast<int>(cell));
+			}
+		}
+		m_bandTouched.clear();
+		for (int idx : m_touched)
+		{
+			m_logOdds[static_cast<size_t>(idx)] = columnLogOdds(static_cast<size_t>(idx));
+			m_scratch[static_cast<size_t>(idx)] = 0.0f;
+		}
+		m_touched.clear();
+		return;
+	}
 	for (int idx : m_touched)
 	{
 		float& l = m_logOdds[static_cast<size_t>(idx)];
@@ -230,8 +335,15 @@ std::vector<TPoint3Df> CISMOccupancyGrid2D::reduceDepth(
 		TPoint3Df obstacle;
 		bool hasFloor{false};
 		TPoint3Df floor;
+		uint64_t slicesSeen{0}, slicesKept{0};  // heightBand: slices with 1 / enough points
 	};
 	std::vector<Acc> acc(static_cast<size_t>(n) * n);
+	// heightBand: one point for each further height slice of a cell (it marks that slice
+	// occupied at the end of the cell's ray), with its accumulator index.
+	const bool band = heightBand();
+	const int slices = bandSlicesWanted();
+	const float sliceH = static_cast<float>(o.bandSliceHeight);
+	std::vector<std::pair<size_t, TPoint3Df>> slicePoints;
 
 	const int rows = static_cast<int>(obs.rangeImage.rows());
 	const int cols = static_cast<int>(obs.rangeImage.cols());
@@ -266,10 +378,22 @@ std::vector<TPoint3Df> CISMOccupancyGrid2D::reduceDepth(
 			if (!(d2 <= maxR2)) continue;
 			const int ix = static_cast<int>((px - ox) * inv), iy = static_cast<int>((py - oy) * inv);
 			if (ix < 0 || iy < 0 || ix >= n || iy >= n) continue;
-			Acc& a = acc[static_cast<size_t>(ix) + static_cast<size_t>(iy) * n];
+			const size_t ai = static_cast<size_t>(ix) + static_cast<size_t>(iy) * n;
+			Acc& a = acc[ai];
 			if (obstacle)
 			{
 				a.obstacles++;
+				if (band)
+				{
+					const uint64_t bit = uint64_t{1} << std::clamp(static_cast<int>((pz - hMin) / sliceH), 0, slices - 1);
+					const bool enough = o.minPointsPerCell <= 1 || (a.slicesSeen & bit);
+					a.slicesSeen |= bit;
+					if (enough && !(a.slicesKept & bit))
+					{
+						a.slicesKept |= bit;
+						slicePoints.emplace_back(ai, TPoint3Df(pcx, pcy, z));
+					}
+				}
 				if (d2 < a.bestRange)
 				{
 					a.bestRange = d2;
@@ -288,6 +412,8 @@ std::vector<TPoint3Df> CISMOccupancyGrid2D::reduceDepth(
 		if (a.obstacles >= o.minPointsPerCell) out.push_back(a.obstacle);
 		if (a.hasFloor) out.push_back(a.floor);
 	}
+	for (const auto& [ai, p] : slicePoints)
+		if (acc[ai].obstacles >= o.minPointsPerCell) out.push_back(p);
 	return out;
 }
 
@@ -356,6 +482,7 @@ double CISMOccupancyGrid2D::applyTrajectoryCorrection(const std::map<uint64_t, C
 		it->second.T_world_cam = pose;
 	}
 	std::fill(m_logOdds.begin(), m_logOdds.end(), 0.0f);
+	std::fill(m_band.begin(), m_band.end(), 0.0f);
 	for (const auto& [id, kf] : m_keyframes) integrateRays(kf.T_world_cam, kf.points_cam);
 	m_lastRebuildSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	return m_lastRebuildSeconds;

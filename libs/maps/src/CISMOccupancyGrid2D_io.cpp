@@ -38,8 +38,9 @@ void writeOptions(CArchive& out, const CISMOccupancyGrid2D::TInsertionOptions& o
 		<< r.minInlierFraction << r.minCameraHeight << r.seed;
 	out << static_cast<uint8_t>(o.rayTraversal) << static_cast<int32_t>(o.depthDecimation)
 		<< static_cast<int32_t>(o.minPointsPerCell) << o.occupiedThreshold << o.freeThreshold;
+	out << static_cast<uint8_t>(o.freeSpaceModel) << o.bandSliceHeight;  // since version 1
 }
-void readOptions(CArchive& in, CISMOccupancyGrid2D::TInsertionOptions& o)
+void readOptions(CArchive& in, CISMOccupancyGrid2D::TInsertionOptions& o, uint8_t version)
 {
 	uint8_t noise = 0, trav = 0;
 	int32_t iters = 0, dec = 0, minPts = 0;
@@ -60,10 +61,19 @@ void readOptions(CArchive& in, CISMOccupancyGrid2D::TInsertionOptions& o)
 	r.iterations = iters;
 	o.depthDecimation = dec;
 	o.minPointsPerCell = minPts;
+	// Version 0 grids were all built with the paper's free-space model.
+	o.freeSpaceModel = CISMOccupancyGrid2D::FreeSpaceModel::Paper;
+	if (version >= 1)
+	{
+		uint8_t model = 0;
+		in >> model >> o.bandSliceHeight;
+		if (model > 1) throw std::runtime_error("CISMOccupancyGrid2D: corrupt freeSpaceModel in serialized options");
+		o.freeSpaceModel = static_cast<CISMOccupancyGrid2D::FreeSpaceModel>(model);
+	}
 }
 }  // namespace
 
-uint8_t CISMOccupancyGrid2D::serializeGetVersion() const { return 0; }
+uint8_t CISMOccupancyGrid2D::serializeGetVersion() const { return 1; }
 
 void CISMOccupancyGrid2D::serializeTo(CArchive& out) const
 {
@@ -85,6 +95,7 @@ void CISMOccupancyGrid2D::serializeTo(CArchive& out) const
 		}
 	}
 	out << m_nextAutoKeyframeId << m_lastRebuildSeconds;
+	out << static_cast<int32_t>(m_bandSlices) << m_band;
 }
 
 void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
@@ -92,9 +103,10 @@ void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
 	switch (version)
 	{
 		case 0:
+		case 1:
 		{
 			readOptions(in, creationOptions);
-			readOptions(in, insertionOptions);
+			readOptions(in, insertionOptions, version);
 			int32_t dec = 0;
 			in >> dec >> likelihoodOptions.outlierProbability;
 			likelihoodOptions.decimation = dec;
@@ -124,8 +136,20 @@ void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
 				m_keyframes[id] = std::move(kf);
 			}
 			in >> m_nextAutoKeyframeId >> m_lastRebuildSeconds;
+			m_band.clear();
+			m_bandSlices = 0;
+			if (version >= 1)
+			{
+				int32_t slices = 0;
+				in >> slices >> m_band;
+				if (!m_band.empty() && (slices < 1 || slices > 64 || m_band.size() != m_logOdds.size() * static_cast<size_t>(slices + 1)))
+					throw std::runtime_error("CISMOccupancyGrid2D: serialized height band size mismatch");
+				m_bandSlices = m_band.empty() ? 0 : slices;
+			}
 			m_scratch.assign(m_logOdds.size(), 0.0f);
+			m_bandScratch.assign(m_band.size(), 0.0f);
 			m_touched.clear();
+			m_bandTouched.clear();
 		}
 		break;
 		default: MRPT_THROW_UNKNOWN_SERIALIZATION_VERSION(version);

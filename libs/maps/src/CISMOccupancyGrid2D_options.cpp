@@ -118,6 +118,13 @@ void CISMOccupancyGrid2D::TInsertionOptions::loadFromConfigFile(
 		floorUpHint = mrpt::math::TVector3D(x, y, z);
 	}
 	floorRansac.loadFromConfigFile(c, s);
+	const std::string model = c.read_string(s, "freeSpaceModel", freeSpaceModel == FreeSpaceModel::HeightBand ? "heightBand" : "paper");
+	if (model == "heightBand") freeSpaceModel = FreeSpaceModel::HeightBand;
+	else if (model == "paper")
+		freeSpaceModel = FreeSpaceModel::Paper;
+	else
+		badKey(s, "freeSpaceModel", model, "expected 'heightBand' or 'paper'");
+	bandSliceHeight = c.read_double(s, "bandSliceHeight", bandSliceHeight);
 	const std::string trav = c.read_string(s, "rayTraversal", rayTraversal == RayTraversal::Bresenham ? "bresenham" : "antialiased");
 	if (trav == "bresenham") rayTraversal = RayTraversal::Bresenham;
 	else if (trav == "antialiased")
@@ -157,6 +164,8 @@ void CISMOccupancyGrid2D::TInsertionOptions::saveToConfigFile(
 	c.write(s, "estimateFloorFromDepth", estimateFloorFromDepth);
 	c.write(s, "floorUpHint", std::to_string(floorUpHint.x) + " " + std::to_string(floorUpHint.y) + " " + std::to_string(floorUpHint.z));
 	floorRansac.saveToConfigFile(c, s);
+	c.write(s, "freeSpaceModel", freeSpaceModel == FreeSpaceModel::HeightBand ? "heightBand" : "paper");
+	c.write(s, "bandSliceHeight", bandSliceHeight);
 	c.write(s, "rayTraversal", rayTraversal == RayTraversal::Bresenham ? "bresenham" : "antialiased");
 	c.write(s, "depthDecimation", depthDecimation);
 	c.write(s, "minPointsPerCell", minPointsPerCell);
@@ -186,6 +195,9 @@ void CISMOccupancyGrid2D::TInsertionOptions::validate() const
 	if (!(obstacleMaxHeight > obstacleMinHeight))
 		badKey(s, "obstacleMaxHeight", str(obstacleMaxHeight), "must exceed obstacleMinHeight");
 	if (!(floorTolerance >= 0)) badKey(s, "floorTolerance", str(floorTolerance), "must be >= 0 m");
+	if (!(bandSliceHeight > 0)) badKey(s, "bandSliceHeight", str(bandSliceHeight), "must be > 0 m");
+	if (!(std::ceil((obstacleMaxHeight - obstacleMinHeight) / bandSliceHeight - 1e-9) <= 64))
+		badKey(s, "bandSliceHeight", str(bandSliceHeight), "the obstacle band may have at most 64 height slices");
 	if (depthDecimation < 1) badKey(s, "depthDecimation", str(depthDecimation), "must be >= 1");
 	if (minPointsPerCell < 1) badKey(s, "minPointsPerCell", str(minPointsPerCell), "must be >= 1");
 	if (!(occupiedThreshold > pPrior && occupiedThreshold < 1))

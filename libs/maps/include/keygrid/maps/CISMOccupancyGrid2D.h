@@ -79,6 +79,20 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 		AntiAliased = 1  ///< Xiaolin Wu: two cells per step, weights sum to one
 	};
 
+	/** How rays make free space. */
+	enum class FreeSpaceModel : uint8_t
+	{
+		/** Height-aware: each column keeps the log-odds of height slices of the obstacle band and
+		 * of its ground clearance (below obstacleMinHeight). A ray updates only the slices it
+		 * crosses in a column, so obstacle evidence is never erased by rays passing above or
+		 * below it; a column is free only when its clearance was seen free and no slice holds
+		 * obstacle evidence. */
+		HeightBand = 0,
+		/** Lu & Wang (2018): every 2D cell before a hit is free, whatever the ray's height there
+		 * (a ray to a wall above a table frees the table's cells). */
+		Paper = 1
+	};
+
 	/** Insertion options: ISM, noise, height band, floor frame, traversal, thresholds. */
 	struct TInsertionOptions : public mrpt::config::CLoadableOptions
 	{
@@ -114,6 +128,10 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 		mrpt::math::TVector3D floorUpHint{0, 0, 0};
 		/** RANSAC parameters of that estimate */
 		maps::FloorPlaneRansacOptions floorRansac;
+		/** Free-space model: "heightBand" or "paper" (Default: heightBand) */
+		FreeSpaceModel freeSpaceModel{FreeSpaceModel::HeightBand};
+		/** heightBand: thickness of the height slices of the obstacle band [m] (Default: 0.05 m) */
+		double bandSliceHeight{0.05};
 		/** Ray traversal: "bresenham" or "antialiased" (Default: bresenham) */
 		RayTraversal rayTraversal{RayTraversal::Bresenham};
 		/** Dense depth: use every n-th pixel in rows and columns (Default: 1) */
@@ -265,15 +283,30 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	double m_resolution{0.05};
 	double m_xMin{0}, m_yMin{0};
 	int m_sizeX{0}, m_sizeY{0};
-	std::vector<float> m_logOdds;  ///< row-major, index cx + cy * m_sizeX
+	std::vector<float> m_logOdds;  ///< row-major, index cx + cy * m_sizeX; heightBand: the column value
+	/** heightBand: per cell, bandStride() values: [0] ground clearance, [1..K] the band's height
+	 * slices from obstacleMinHeight up (log-odds relative to the prior); empty in paper mode. */
+	std::vector<float> m_band;
+	int m_bandSlices{0};  ///< K, the number of height slices m_band was laid out for
 	mrpt::poses::CPose3D m_T_world_floorEstimate;  ///< RANSAC estimate, if m_floorEstimated
 	bool m_floorEstimated{false};
 	std::map<uint64_t, KeyframeRays> m_keyframes;
 	uint64_t m_nextAutoKeyframeId{1ULL << 62};  ///< ids for insertObservation() inputs
 	double m_lastRebuildSeconds{0};
-	/** Per-insertion scratch: the one update each cell gets from the current keyframe. */
-	std::vector<float> m_scratch;
+	/** Per-insertion scratch: the one update each cell (heightBand: each slice) gets from the
+	 * current keyframe, and the indices touched. */
+	std::vector<float> m_scratch, m_bandScratch;
 	std::vector<int> m_touched;
+	std::vector<size_t> m_bandTouched;
+
+	bool heightBand() const { return insertionOptions.freeSpaceModel == FreeSpaceModel::HeightBand; }
+	/** Number of height slices the insertion options ask for. */
+	int bandSlicesWanted() const;
+	/** (Re)allocates m_band for the current grid size and options, cleared. */
+	void resetBand();
+	/** The column log-odds of a cell from its band values: the strongest obstacle evidence in
+	 * the band if any is positive, else the ground clearance. */
+	float columnLogOdds(size_t cell) const;
 
 	void resetGeometry(const TCreationOptions& c);
 	/** Grows the grid (keeping contents) to cover [x0,x1]x[y0,y1] of the floor frame. */
