@@ -28,7 +28,12 @@ CISMOccupancyGrid2D::RayTraversal traversal(int64_t arg)
 	return arg ? CISMOccupancyGrid2D::RayTraversal::AntiAliased : CISMOccupancyGrid2D::RayTraversal::Bresenham;
 }
 
-/** Args: {points per keyframe, traversal (0 Bresenham, 1 anti-aliased)} */
+CISMOccupancyGrid2D::FreeSpaceModel freeSpace(int64_t arg)
+{
+	return arg ? CISMOccupancyGrid2D::FreeSpaceModel::Paper : CISMOccupancyGrid2D::FreeSpaceModel::HeightBand;
+}
+
+/** Args: {points per keyframe, traversal (0 Bresenham, 1 anti-aliased), free space (0 heightBand, 1 paper)} */
 void BM_SparseKeyframe(benchmark::State& state)
 {
 	SyntheticRoom room;
@@ -39,6 +44,7 @@ void BM_SparseKeyframe(benchmark::State& state)
 	CISMOccupancyGrid2D grid;
 	grid.insertionOptions.rangeNoise = keygrid::maps::RangeNoiseModel::Constant;
 	grid.insertionOptions.rayTraversal = traversal(state.range(1));
+	grid.insertionOptions.freeSpaceModel = freeSpace(state.range(2));
 	size_t k = 0;
 	for (auto _ : state)
 	{
@@ -47,9 +53,10 @@ void BM_SparseKeyframe(benchmark::State& state)
 	}
 	state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * state.range(0));
 }
-BENCHMARK(BM_SparseKeyframe)->ArgsProduct({{100, 500, 2000}, {0, 1}})->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SparseKeyframe)->ArgsProduct({{100, 500, 2000}, {0, 1}, {0, 1}})->Unit(benchmark::kMicrosecond);
 
-/** Args: {traversal, depth decimation} — full 640x480 Kinect-like depth image per iteration. */
+/** Args: {traversal, depth decimation, free space (0 heightBand, 1 paper)} — full 640x480
+ * Kinect-like depth image per iteration. */
 void BM_DenseDepth640x480(benchmark::State& state)
 {
 	SyntheticRoom room;
@@ -59,6 +66,7 @@ void BM_DenseDepth640x480(benchmark::State& state)
 	CISMOccupancyGrid2D grid;
 	grid.insertionOptions.rayTraversal = traversal(state.range(0));
 	grid.insertionOptions.depthDecimation = static_cast<int>(state.range(1));
+	grid.insertionOptions.freeSpaceModel = freeSpace(state.range(2));
 	size_t k = 0;
 	for (auto _ : state)
 	{
@@ -67,7 +75,7 @@ void BM_DenseDepth640x480(benchmark::State& state)
 	}
 	state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * 640 * 480);
 }
-BENCHMARK(BM_DenseDepth640x480)->ArgsProduct({{0, 1}, {1, 2}})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DenseDepth640x480)->ArgsProduct({{0, 1}, {1, 2}, {0, 1}})->Unit(benchmark::kMillisecond);
 
 /** Arg: number of stored keyframes (500 map points each) rebuilt after a correction. */
 void BM_RebuildAfterCorrection(benchmark::State& state)

@@ -38,7 +38,12 @@ enum class CellState : uint8_t
  * not gravity aligned). A 3D point p_F is an obstacle when obstacleMinHeight <= z <=
  * obstacleMaxHeight, floor when |z| <= floorTolerance (it then only clears space), and ignored
  * otherwise. Every kept point casts a 2D ray from the camera's footprint to the point's
- * footprint; the cells on it are updated with l += logit(ISM(r)) - l0.
+ * footprint; the cells on it are updated with l += logit(ISM(r)) - l0. With the default
+ * freeSpaceModel = heightBand the update goes to the height slices of the obstacle band that
+ * the 3D ray crosses in each cell (and to the cell's ground clearance where the ray is below
+ * obstacleMinHeight); a cell reads occupied when any slice holds obstacle evidence and free only
+ * when its ground clearance was seen free, so rays passing above or below an obstacle never
+ * erase it. freeSpaceModel = paper is the paper's model (every cell before a hit is free).
  *
  * Storage: float log-odds per cell in a grid that grows on demand (in steps of
  * creationOptions.growthMargin) from the creation extent, because a SLAM map's extent is not
@@ -134,8 +139,9 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 		double bandSliceHeight{0.05};
 		/** Ray traversal: "bresenham" or "antialiased" (Default: bresenham) */
 		RayTraversal rayTraversal{RayTraversal::Bresenham};
-		/** Dense depth: use every n-th pixel in rows and columns (Default: 1) */
-		int depthDecimation{1};
+		/** Dense depth: use every n-th pixel in rows and columns. At 2 a 640x480 Kinect image
+		 * still samples a 5 cm cell with 3 pixel rows and columns at maxRange (Default: 2) */
+		int depthDecimation{2};
 		/** Dense depth: minimum points in an endpoint cell before it casts an obstacle ray,
 		 * rejects speckle (Default: 2) */
 		int minPointsPerCell{2};
