@@ -16,7 +16,7 @@
 #   --out DIR          renders (kept and reused) and runs (redone every time) (default:
 #                      /tmp/keygrid_nav_safety)
 #   --scenes LIST      names under config/sim/ (default: room_loop room_survey corridor_loop
-#                      office_loop relocalization; office_loop renders 3300 frames, ~2 min)
+#                      office_loop relocalization; office_loop is 3300 frames)
 #   --models LIST      values of the 2D grid's freeSpaceModel (default: heightBand paper)
 #   --inputs LIST      values of [maps] ism2d_input (default: sparse dense)
 #   --max-frames N     keygrid-slam stops after N frames (the render stays complete) (default: all)
