@@ -16,6 +16,41 @@ FloorPlanGrid::Cell FloorPlanGrid::at(double x, double y) const
 		static_cast<int>(std::floor((y - yMin) / resolution)));
 }
 
+bool FloorPlanGrid::inView(int cx, int cy) const
+{
+	if (seen.empty()) return true;
+	const Cell c = cell(cx, cy);
+	if (c == Ignore) return false;
+	const uint8_t bit = c == Occupied ? SeenSurface : SeenFreeSpace;
+	return (seen[static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX] & bit) != 0;
+}
+
+bool OccupancyMetricsOptions::isValid(std::string* error) const
+{
+	std::string why;
+	if (!(matchTolerance >= 0)) why = "matchTolerance must be >= 0 m (got " + std::to_string(matchTolerance) + ")";
+	else if (hazardMarginCells < 0)
+		why = "hazardMarginCells must be >= 0 (got " + std::to_string(hazardMarginCells) + ")";
+	if (error) *error = why;
+	return why.empty();
+}
+
+const char* cellVerdictName(CellVerdict v)
+{
+	switch (v)
+	{
+		case CellVerdict::Unknown: return "unknown";
+		case CellVerdict::Free: return "free";
+		case CellVerdict::Occupied: return "occupied";
+		case CellVerdict::Missed: return "missed";
+		case CellVerdict::MissedUnseen: return "missed, never in view";
+		case CellVerdict::EdgeCalledFree: return "obstacle edge called free";
+		case CellVerdict::Hazard: return "hazard";
+		case CellVerdict::FalseObstacle: return "false obstacle";
+	}
+	return "?";
+}
+
 namespace
 {
 /** Uniform read access to a CISMOccupancyGrid2D or a TriStateGrid for the scoring below. */
@@ -34,46 +69,105 @@ struct EstView
 	CellState stateAt(double x, double y) const { return state(x2idx(x), y2idx(y)); }
 };
 
+EstView viewOf(const TriStateGrid& est)
+{
+	return EstView{est.resolution, est.xMin, est.yMin, est.sizeX, est.sizeY,
+		[&est](int cx, int cy) { return est.cell(cx, cy); }};
+}
+
+/** The neighbourhood queries and the per-cell verdict shared by the metrics and the overlay. */
+class Scorer
+{
+   public:
+	Scorer(const EstView& est, const FloorPlanGrid& gt, const OccupancyMetricsOptions& opts)
+		: m_est(est), m_gt(gt), m_opts(opts), m_tol2(opts.matchTolerance * opts.matchTolerance + 1e-12)
+	{
+		std::string why;
+		if (!opts.isValid(&why)) throw std::invalid_argument("OccupancyMetricsOptions: " + why);
+		if (!gt.seen.empty() && gt.seen.size() != gt.cells.size())
+			throw std::invalid_argument(
+				"FloorPlanGrid::seen has " + std::to_string(gt.seen.size()) + " cells, the plan " +
+				std::to_string(gt.cells.size()));
+	}
+
+	/** Any estimated occupied cell whose centre lies within tolerance of (x, y)? */
+	bool estHasOccupiedNear(double x, double y) const
+	{
+		const double res = m_est.resolution();
+		const int r = static_cast<int>(std::ceil(m_opts.matchTolerance / res));
+		const int cx = m_est.x2idx(x), cy = m_est.y2idx(y);
+		for (int dy = -r; dy <= r; dy++)
+			for (int dx = -r; dx <= r; dx++)
+			{
+				const double ex = m_est.idx2x(cx + dx) - x, ey = m_est.idx2y(cy + dy) - y;
+				if (ex * ex + ey * ey <= m_tol2 + 0.5 * res * res &&
+					m_est.cellState(cx + dx, cy + dy) == CellState::Occupied)
+					return true;
+			}
+		return false;
+	}
+	/** Any GT-occupied cell whose centre lies within tolerance of (x, y)? */
+	bool gtHasOccupiedNear(double x, double y) const
+	{
+		const double res = m_gt.resolution;
+		const int r = static_cast<int>(std::ceil(m_opts.matchTolerance / res));
+		const int cx = static_cast<int>(std::floor((x - m_gt.xMin) / res));
+		const int cy = static_cast<int>(std::floor((y - m_gt.yMin) / res));
+		for (int dy = -r; dy <= r; dy++)
+			for (int dx = -r; dx <= r; dx++)
+			{
+				const double gx = m_gt.xMin + (cx + dx + 0.5) * res - x;
+				const double gy = m_gt.yMin + (cy + dy + 0.5) * res - y;
+				if (gx * gx + gy * gy <= m_tol2 + 0.5 * res * res &&
+					m_gt.cell(cx + dx, cy + dy) == FloorPlanGrid::Occupied)
+					return true;
+			}
+		return false;
+	}
+	/** Any GT-free cell within Chebyshev distance r of GT cell (cx, cy)? */
+	bool gtFreeWithin(int cx, int cy, int r) const
+	{
+		for (int dy = -r; dy <= r; dy++)
+			for (int dx = -r; dx <= r; dx++)
+				if (m_gt.cell(cx + dx, cy + dy) == FloorPlanGrid::Free) return true;
+		return false;
+	}
+	double centreX(int cx) const { return m_gt.xMin + (cx + 0.5) * m_gt.resolution; }
+	double centreY(int cy) const { return m_gt.yMin + (cy + 0.5) * m_gt.resolution; }
+
+	CellVerdict verdict(int cx, int cy) const
+	{
+		const auto g = m_gt.cell(cx, cy);
+		if (g == FloorPlanGrid::Ignore) return CellVerdict::Unknown;
+		const double x = centreX(cx), y = centreY(cy);
+		const CellState s = m_est.stateAt(x, y);
+		if (g == FloorPlanGrid::Occupied)
+		{
+			if (s == CellState::Free)
+				return gtFreeWithin(cx, cy, m_opts.hazardMarginCells) ? CellVerdict::EdgeCalledFree : CellVerdict::Hazard;
+			if (estHasOccupiedNear(x, y)) return CellVerdict::Occupied;
+			return m_gt.inView(cx, cy) ? CellVerdict::Missed : CellVerdict::MissedUnseen;
+		}
+		if (s == CellState::Free) return CellVerdict::Free;
+		if (s == CellState::Occupied) return gtHasOccupiedNear(x, y) ? CellVerdict::Occupied : CellVerdict::FalseObstacle;
+		return CellVerdict::Unknown;
+	}
+
+   private:
+	const EstView& m_est;
+	const FloorPlanGrid& m_gt;
+	const OccupancyMetricsOptions& m_opts;
+	const double m_tol2;
+};
+
 OccupancyMetrics evaluate(const EstView& est, const FloorPlanGrid& gt, const OccupancyMetricsOptions& opts)
 {
-	const int sizeXEst = est.sizeX, sizeYEst = est.sizeY;
+	const Scorer sc(est, gt, opts);
 	OccupancyMetrics m;
-	const double tol = opts.matchTolerance;
-	const double tol2 = tol * tol + 1e-12;
-
-	// Any cell of `state` in `grid` within tol of (x, y)? Checks cell centres.
-	auto estHasOccupiedNear = [&](double x, double y) {
-		const int r = static_cast<int>(std::ceil(tol / est.resolution()));
-		const int cx = est.x2idx(x), cy = est.y2idx(y);
-		for (int dy = -r; dy <= r; dy++)
-			for (int dx = -r; dx <= r; dx++)
-			{
-				const double ex = est.idx2x(cx + dx) - x, ey = est.idx2y(cy + dy) - y;
-				if (ex * ex + ey * ey <= tol2 + 0.5 * est.resolution() * est.resolution() &&
-					est.cellState(cx + dx, cy + dy) == CellState::Occupied)
-					return true;
-			}
-		return false;
-	};
-	auto gtHasOccupiedNear = [&](double x, double y) {
-		const int r = static_cast<int>(std::ceil(tol / gt.resolution));
-		const int cx = static_cast<int>(std::floor((x - gt.xMin) / gt.resolution));
-		const int cy = static_cast<int>(std::floor((y - gt.yMin) / gt.resolution));
-		for (int dy = -r; dy <= r; dy++)
-			for (int dx = -r; dx <= r; dx++)
-			{
-				const double gx = gt.xMin + (cx + dx + 0.5) * gt.resolution - x;
-				const double gy = gt.yMin + (cy + dy + 0.5) * gt.resolution - y;
-				if (gx * gx + gy * gy <= tol2 + 0.5 * gt.resolution * gt.resolution &&
-					gt.cell(cx + dx, cy + dy) == FloorPlanGrid::Occupied)
-					return true;
-			}
-		return false;
-	};
 
 	// Precision side and free precision: iterate the estimate.
-	for (int cy = 0; cy < sizeYEst; cy++)
-		for (int cx = 0; cx < sizeXEst; cx++)
+	for (int cy = 0; cy < est.sizeY; cy++)
+		for (int cx = 0; cx < est.sizeX; cx++)
 		{
 			const double x = est.idx2x(cx), y = est.idx2y(cy);
 			const auto g = gt.at(x, y);
@@ -82,7 +176,7 @@ OccupancyMetrics evaluate(const EstView& est, const FloorPlanGrid& gt, const Occ
 			if (s == CellState::Occupied)
 			{
 				m.estOccupied++;
-				if (gtHasOccupiedNear(x, y)) m.estOccupiedMatched++;
+				if (sc.gtHasOccupiedNear(x, y)) m.estOccupiedMatched++;
 			}
 			else if (s == CellState::Free)
 			{
@@ -90,25 +184,41 @@ OccupancyMetrics evaluate(const EstView& est, const FloorPlanGrid& gt, const Occ
 				if (g == FloorPlanGrid::Free) m.estFreeCorrect++;
 			}
 		}
-	// Recall side and free accuracy: iterate the ground truth.
+	// Recall side, free accuracy and the navigation metrics: iterate the ground truth.
 	for (int cy = 0; cy < gt.sizeY; cy++)
 		for (int cx = 0; cx < gt.sizeX; cx++)
 		{
 			const auto g = gt.cell(cx, cy);
-			const double x = gt.xMin + (cx + 0.5) * gt.resolution;
-			const double y = gt.yMin + (cy + 0.5) * gt.resolution;
+			const double x = sc.centreX(cx), y = sc.centreY(cy);
+			const CellState s = est.stateAt(x, y);
 			if (g == FloorPlanGrid::Occupied)
 			{
 				m.gtOccupied++;
-				if (estHasOccupiedNear(x, y)) m.gtOccupiedMatched++;
+				const bool matched = sc.estHasOccupiedNear(x, y);
+				if (matched) m.gtOccupiedMatched++;
+				if (s == CellState::Free) m.gtOccupiedCalledFree++;
+				if (!sc.gtFreeWithin(cx, cy, opts.hazardMarginCells))
+				{
+					m.gtOccupiedInterior++;
+					if (s == CellState::Free) m.hazardCells++;
+				}
+				if (sc.gtFreeWithin(cx, cy, 1) && gt.inView(cx, cy))
+				{
+					m.gtBoundarySeen++;
+					if (matched) m.gtBoundarySeenMatched++;
+				}
 			}
 			else if (g == FloorPlanGrid::Free)
 			{
-				const CellState s = est.stateAt(x, y);
+				if (gt.inView(cx, cy))
+				{
+					m.gtFreeSeen++;
+					if (s == CellState::Free) m.gtFreeSeenCalledFree++;
+				}
 				if (s == CellState::Unknown) continue;
 				m.gtFreeObserved++;
 				if (s == CellState::Free) m.gtFreeCorrect++;
-				if (gtHasOccupiedNear(x, y))
+				if (sc.gtHasOccupiedNear(x, y))
 				{
 					m.gtFreeObservedNearOccupied++;
 					if (s == CellState::Free) m.gtFreeCorrectNearOccupied++;
@@ -116,13 +226,17 @@ OccupancyMetrics evaluate(const EstView& est, const FloorPlanGrid& gt, const Occ
 			}
 		}
 	auto ratio = [](size_t a, size_t b) { return b ? static_cast<double>(a) / static_cast<double>(b) : 0.0; };
+	auto harmonic = [](double p, double r) { return (p + r) > 0 ? 2 * p * r / (p + r) : 0.0; };
 	m.precision = ratio(m.estOccupiedMatched, m.estOccupied);
 	m.recall = ratio(m.gtOccupiedMatched, m.gtOccupied);
-	m.f1 = (m.precision + m.recall) > 0 ? 2 * m.precision * m.recall / (m.precision + m.recall) : 0.0;
+	m.f1 = harmonic(m.precision, m.recall);
 	m.freeAccuracy = ratio(m.gtFreeCorrect, m.gtFreeObserved);
 	m.freeAccuracyAwayFromOccupied = ratio(
 		m.gtFreeCorrect - m.gtFreeCorrectNearOccupied, m.gtFreeObserved - m.gtFreeObservedNearOccupied);
 	m.freePrecision = ratio(m.estFreeCorrect, m.estFree);
+	m.boundaryRecall = ratio(m.gtBoundarySeenMatched, m.gtBoundarySeen);
+	m.freeRecall = ratio(m.gtFreeSeenCalledFree, m.gtFreeSeen);
+	m.freeF1 = harmonic(m.freePrecision, m.freeRecall);
 	return m;
 }
 }  // namespace
@@ -130,10 +244,7 @@ OccupancyMetrics evaluate(const EstView& est, const FloorPlanGrid& gt, const Occ
 OccupancyMetrics evaluateOccupancy(
 	const TriStateGrid& est, const FloorPlanGrid& gt, const OccupancyMetricsOptions& opts)
 {
-	return evaluate(
-		EstView{est.resolution, est.xMin, est.yMin, est.sizeX, est.sizeY,
-			[&](int cx, int cy) { return est.cell(cx, cy); }},
-		gt, opts);
+	return evaluate(viewOf(est), gt, opts);
 }
 
 OccupancyMetrics evaluateOccupancy(
@@ -143,6 +254,17 @@ OccupancyMetrics evaluateOccupancy(
 		EstView{est.resolution(), est.xMin(), est.yMin(), est.sizeX(), est.sizeY(),
 			[&](int cx, int cy) { return est.cellState(cx, cy); }},
 		gt, opts);
+}
+
+std::vector<CellVerdict> classifyCells(const TriStateGrid& est, const FloorPlanGrid& gt, const OccupancyMetricsOptions& opts)
+{
+	const EstView view = viewOf(est);
+	const Scorer sc(view, gt, opts);
+	std::vector<CellVerdict> v(static_cast<size_t>(gt.sizeX) * static_cast<size_t>(gt.sizeY));
+	for (int cy = 0; cy < gt.sizeY; cy++)
+		for (int cx = 0; cx < gt.sizeX; cx++)
+			v[static_cast<size_t>(cx) + static_cast<size_t>(cy) * gt.sizeX] = sc.verdict(cx, cy);
+	return v;
 }
 
 TriStateGrid TriStateGrid::fromGrid(const CISMOccupancyGrid2D& g)

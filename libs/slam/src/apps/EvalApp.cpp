@@ -2,12 +2,38 @@
 #include <keygrid/eval/TrajectoryErrors.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/EvalApp.h>
+#include <keygrid/slam/apps/MapEvaluation.h>
 #include <keygrid/slam/AtomicFile.h>
+#include <mrpt/math/CMatrixFixed.h>
 
 #include <iostream>
 
 namespace keygrid::slam
 {
+namespace
+{
+/** The SE(3) part of the trajectory alignment as a pose: T_gt_est. */
+mrpt::poses::CPose3D toPose(const eval::Similarity3& a)
+{
+	mrpt::math::CMatrixDouble44 H;
+	H.setIdentity();
+	for (int r = 0; r < 3; r++)
+	{
+		for (int c = 0; c < 3; c++) H(r, c) = a.R(r, c);
+		H(r, 3) = a.t(r);
+	}
+	return mrpt::poses::CPose3D(H);
+}
+
+/** The trajectory JSON object with the map's fields appended. */
+std::string mergeJson(const std::string& trajectoryJson, const std::string& mapFields)
+{
+	const auto close = trajectoryJson.find_last_of('}');
+	auto end = trajectoryJson.find_last_not_of(" \n", close - 1);
+	return trajectoryJson.substr(0, end + 1) + ",\n" + mapFields + "\n}\n";
+}
+}  // namespace
+
 int EvalApp::run(int argc, const char* const* argv)
 {
 	return runApp("keygrid-eval", [&] {
@@ -15,14 +41,27 @@ int EvalApp::run(int argc, const char* const* argv)
 			"keygrid-eval",
 			"Evaluates an estimated TUM trajectory against ground truth: associates poses by\n"
 			"timestamp, aligns positions (SE(3) Horn/Umeyama, or Sim(3) with --sim3), and reports\n"
-			"the absolute trajectory error (ATE) and the relative pose error (RPE) per second.");
+			"the absolute trajectory error (ATE) and the relative pose error (RPE) per second.\n"
+			"With --map and --floorplan it also scores keygrid-slam's 2D grid against keygrid-sim's\n"
+			"floor plan, carried into the ground-truth world by the same alignment: hazard cells\n"
+			"(obstacles called free), obstacle recall over the boundary cells the cameras saw,\n"
+			"obstacle precision, free-space F1, the floor estimate's error; --overlay draws the\n"
+			"map over the plan (colours: doc/maps-ism2d.md).");
 		cl.option("gt", "GT.txt", "ground-truth trajectory (TUM format)", true)
 			.option("est", "EST.txt", "estimated trajectory (TUM format)", true)
-			.option("json", "OUT.json", "also write the results as JSON (keys ate_rmse_m, rpe_trans_m_per_s, rpe_rot_deg_per_s, matched, ...)")
+			.option("json", "OUT.json", "also write the results as JSON (keys ate_rmse_m, rpe_trans_m_per_s, rpe_rot_deg_per_s, matched, ...; map_* with --map)")
 			.option("max-dt", "SECONDS", "largest timestamp difference for a match", false, "0.02")
 			.option("delta", "SECONDS", "RPE time step", false, "1.0")
+			.option("map", "MAP_2D.yaml", "keygrid-slam's 2D grid (its first line holds the floor pose) to score; needs --floorplan")
+			.option("floorplan", "PLAN.yaml", "keygrid-sim's ground-truth floor plan (floorplan.yaml)")
+			.option("scene", "SCENE.ini", "with --keyframes: render the scene at the keyframes' ground-truth poses to know which cells the cameras saw")
+			.option("keyframes", "KF.txt", "keyframe timestamps (keygrid-slam's keyframes.txt), with --scene")
+			.option("overlay", "OUT.png", "write the map laid over the floor plan (occupied / free / missed / hazard / false obstacle)")
+			.option("tolerance", "M", "occupied cells match within this distance", false, "0.05")
+			.option("max-range", "M", "horizontal range of the cameras' view for --scene", false, "4.5")
 			.flag("sim3", "align with scale (for monocular or scale-drifting estimates)")
-			.flag("skip-bad-lines", "skip malformed lines (reported) instead of failing");
+			.flag("skip-bad-lines", "skip malformed lines (reported) instead of failing")
+			.flag("quiet", "no progress output");
 		if (!cl.parse(argc, argv)) return 0;
 		eval::TrajectoryErrorOptions opts;
 		opts.maxDt = cl.getDouble("max-dt");
@@ -30,6 +69,30 @@ int EvalApp::run(int argc, const char* const* argv)
 		opts.withScale = cl.flagSet("sim3");
 		std::string why;
 		if (!opts.isValid(&why)) throw core::CommandLineError(why);
+
+		const bool mapMode = cl.has("map");
+		MapEvaluationOptions mo;
+		if (mapMode)
+		{
+			if (!cl.has("floorplan")) throw core::CommandLineError("--map needs --floorplan");
+			if (opts.withScale) throw core::CommandLineError("--map needs an SE(3) alignment: drop --sim3");
+			if (cl.has("scene") != cl.has("keyframes")) throw core::CommandLineError("--scene and --keyframes go together");
+			mo.mapYaml = cl.get("map");
+			mo.floorPlanYaml = cl.get("floorplan");
+			mo.scenePath = cl.has("scene") ? cl.get("scene") : "";
+			mo.keyframesPath = cl.has("keyframes") ? cl.get("keyframes") : "";
+			mo.overlayPath = cl.has("overlay") ? cl.get("overlay") : "";
+			mo.metrics.matchTolerance = cl.getDouble("tolerance");
+			mo.visibility.maxRange = cl.getDouble("max-range");
+			mo.maxDt = opts.maxDt;
+			mo.progress = !cl.flagSet("quiet");
+			if (!mo.metrics.isValid(&why)) throw core::CommandLineError("--tolerance: " + why);
+			if (!mo.visibility.isValid(&why)) throw core::CommandLineError("--max-range: " + why);
+		}
+		else
+			for (const std::string k : {"floorplan", "scene", "keyframes", "overlay"})
+				if (cl.has(k)) throw core::CommandLineError("--" + k + " needs --map");
+
 		core::TrajectoryReadOptions ro;
 		ro.skipBadLines = cl.flagSet("skip-bad-lines");
 		std::vector<core::TextLineIssue> issues;
@@ -38,7 +101,15 @@ int EvalApp::run(int argc, const char* const* argv)
 		for (const auto& is : issues) std::cerr << "keygrid-eval: skipped " << is.str() << "\n";
 		const auto res = eval::evaluateTrajectory(gt, est, opts);
 		std::cout << res.toText();
-		if (cl.has("json")) writeFileAtomically(cl.get("json"), res.toJson());
+		std::string json = res.toJson();
+		if (mapMode)
+		{
+			const auto m = evaluateMapAgainstFloorPlan(mo, toPose(res.alignment), gt);
+			std::cout << m.toText();
+			if (!mo.overlayPath.empty()) std::cout << "overlay: " << mo.overlayPath << "\n";
+			json = mergeJson(json, m.jsonFields());
+		}
+		if (cl.has("json")) writeFileAtomically(cl.get("json"), json);
 		return 0;
 	});
 }

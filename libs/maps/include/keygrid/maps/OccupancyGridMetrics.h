@@ -1,15 +1,21 @@
 #pragma once
 /** \file OccupancyGridMetrics.h
  * Accuracy of an estimated 2D occupancy grid against a ground-truth floor plan (e.g. the one
- * keygrid-sim writes): occupied-cell precision / recall / F1 with a distance tolerance, and
- * free-space accuracy.
+ * keygrid-sim writes): occupied-cell precision / recall / F1 with a distance tolerance,
+ * free-space accuracy, and the navigation-safety metrics (hazard cells = obstacles called free,
+ * obstacle recall over the boundary the cameras saw, free-space F1); the per-cell classes behind
+ * them, an overlay image of the map on the plan (OccupancyGridMetrics_overlay.cpp) and the
+ * visibility mask of the plan from rendered views (OccupancyGridMetrics_visibility.cpp).
  *
  * It lives in libs/maps, not libs/eval, because it reads CISMOccupancyGrid2D and libs/eval must
  * not depend on maps; the ground truth is a plain struct so a simulator can fill it without
  * linking maps.
  */
+#include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
+#include <opencv2/core/mat.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <optional>
@@ -27,10 +33,20 @@ struct FloorPlanGrid
 		Occupied = 1,
 		Ignore = 2  ///< outside the mapped area: not scored
 	};
+	/** Bits of `seen`. */
+	enum SeenBits : uint8_t
+	{
+		SeenSurface = 1,   ///< a surface point inside the height band was seen in the cell
+		SeenFreeSpace = 2  ///< a ray crossed the cell's column inside the band, or ended on its floor
+	};
 	double resolution{0.05};
 	double xMin{0}, yMin{0};
 	int sizeX{0}, sizeY{0};
 	std::vector<uint8_t> cells;  ///< row-major, index cx + cy * sizeX
+	/** Optional visibility mask on the same lattice (SeenBits; markSeenCells() fills it). Empty =
+	 * no mask: every cell counts as in view. An Occupied cell is in view with SeenSurface, a
+	 * Free cell with SeenFreeSpace. Only the "seen" metrics use it. */
+	std::vector<uint8_t> seen;
 
 	/** Ground truth at a floor-frame position; Ignore outside the lattice. */
 	Cell at(double x, double y) const;
@@ -39,6 +55,8 @@ struct FloorPlanGrid
 		if (cx < 0 || cy < 0 || cx >= sizeX || cy >= sizeY) return Ignore;
 		return static_cast<Cell>(cells[static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX]);
 	}
+	/** Whether the cameras saw cell (cx, cy) in the sense of its class (true without a mask). */
+	bool inView(int cx, int cy) const;
 };
 
 struct OccupancyMetricsOptions
@@ -46,6 +64,13 @@ struct OccupancyMetricsOptions
 	/** An occupied cell matches an occupied cell of the other grid within this distance [m]
 	 * (Default: 0.05 m = one 5 cm cell) */
 	double matchTolerance{0.05};
+	/** A ground-truth obstacle cell with no ground-truth free cell within this many cells
+	 * (Chebyshev distance, so diagonal neighbours count as 1) is "interior": the map calling it
+	 * free is a hazard that no registration or discretisation error of one cell explains
+	 * (Default: 1 cell) */
+	int hazardMarginCells{1};
+
+	bool isValid(std::string* error = nullptr) const;
 };
 
 struct OccupancyMetrics
@@ -68,7 +93,42 @@ struct OccupancyMetrics
 	size_t estFree{0}, estFreeCorrect{0};
 	/** estFreeCorrect / estFree */
 	double freePrecision{0};
+
+	// Navigation safety.
+	/** GT-occupied cells farther than hazardMarginCells from every GT-free cell, and those the
+	 * map calls FREE: hazardCells must be 0 for a navigation-safe map. */
+	size_t gtOccupiedInterior{0}, hazardCells{0};
+	/** All GT-occupied cells the map calls FREE (hazards plus obstacle edges within the margin). */
+	size_t gtOccupiedCalledFree{0};
+	/** Obstacle boundary: GT-occupied cells with a GT-free cell among their 8 neighbours, in
+	 * view (FloorPlanGrid::seen, SeenSurface), and those with an estimated occupied cell within
+	 * matchTolerance (the rule of `recall`). boundaryRecall = matched / seen. */
+	size_t gtBoundarySeen{0}, gtBoundarySeenMatched{0};
+	double boundaryRecall{0};
+	/** GT-free cells in view (SeenFreeSpace; all GT-free cells without a mask) and those the map
+	 * calls free. freeRecall = called free / in view. */
+	size_t gtFreeSeen{0}, gtFreeSeenCalledFree{0};
+	double freeRecall{0};
+	/** Harmonic mean of freePrecision and freeRecall. */
+	double freeF1{0};
 };
+
+/** What a floor-plan cell is, comparing the estimate with the ground truth (the overlay's
+ * colours; doc/maps-ism2d.md has the legend). */
+enum class CellVerdict : uint8_t
+{
+	Unknown = 0,     ///< GT free, map unknown; or not scored (GT Ignore)
+	Free,            ///< GT free, map free
+	Occupied,        ///< map occupied, GT occupied within matchTolerance
+	Missed,          ///< GT obstacle in view, map neither occupied (within tolerance) nor free
+	MissedUnseen,    ///< same, but the cameras never saw the cell (only with a visibility mask)
+	EdgeCalledFree,  ///< GT obstacle within hazardMarginCells of GT free, map free
+	Hazard,          ///< interior GT obstacle, map free
+	FalseObstacle    ///< GT free, map occupied, no GT obstacle within matchTolerance
+};
+constexpr int kCellVerdictCount = 8;
+/** Short English name of a verdict (legend text). */
+const char* cellVerdictName(CellVerdict v);
 
 /** A tri-state grid on its own lattice (e.g. a map_2d.pgm re-read, or a grid resampled into
  * the ground truth's frame). Cell (cx, cy) covers [xMin + cx res, xMin + (cx+1) res) x ... */
@@ -101,12 +161,66 @@ struct TriStateGrid
 	static TriStateGrid loadRosMapServer(const std::string& yamlPath);
 };
 
-/** Scores `est` against `gt` (cells compared at cell centres). */
+/** Scores `est` against `gt` (cells compared at cell centres). Throws std::invalid_argument
+ * naming the field for invalid options or a `gt.seen` of the wrong size. */
 OccupancyMetrics evaluateOccupancy(
 	const TriStateGrid& est, const FloorPlanGrid& gt, const OccupancyMetricsOptions& opts = {});
 /** Same, on the grid's own lattice. */
 OccupancyMetrics evaluateOccupancy(
 	const CISMOccupancyGrid2D& est, const FloorPlanGrid& gt, const OccupancyMetricsOptions& opts = {});
+
+/** The verdict of every cell of `gt` (row-major, gt's lattice; the estimate is read at the
+ * cell centres). Counting them gives the metrics: #Hazard = hazardCells, #Free =
+ * gtFreeCorrect, and so on. */
+std::vector<CellVerdict> classifyCells(
+	const TriStateGrid& est, const FloorPlanGrid& gt, const OccupancyMetricsOptions& opts = {});
+
+struct OverlayImageOptions
+{
+	/** Image pixels per floor-plan cell, each direction (Default: 4) */
+	int pixelsPerCell{4};
+	/** Draw a legend (colour, meaning, cell count) under the map (Default: true) */
+	bool legend{true};
+
+	bool isValid(std::string* error = nullptr) const;
+};
+
+/** RGB colour of a verdict in the overlay image. */
+std::array<uint8_t, 3> cellVerdictColour(CellVerdict v);
+
+/** Writes the estimate laid over the floor plan as a colour image (PNG, or any format MRPT's
+ * CImage writes by extension): one square of pixelsPerCell per plan cell coloured by its
+ * verdict, +y up, with an optional legend. Throws std::runtime_error naming the file when it
+ * cannot be written. Returns the verdict counts (index = CellVerdict). */
+std::array<size_t, kCellVerdictCount> saveOverlayImage(
+	const std::string& path, const TriStateGrid& est, const FloorPlanGrid& gt,
+	const OccupancyMetricsOptions& metricOpts = {}, const OverlayImageOptions& imageOpts = {});
+
+struct FloorPlanVisibilityOptions
+{
+	/** Height band of the plan [m, floor frame] (Default: 0.10 .. 1.80, keygrid-sim's plan) */
+	double zMin{0.10}, zMax{1.80};
+	/** Largest horizontal distance from the camera that counts as seen [m] (Default: 4.5, the
+	 * 2D grid's maxRange) */
+	double maxRange{4.5};
+	/** A point with |z| below this is floor [m] (Default: 0.04, the grid's floorTolerance) */
+	double floorTolerance{0.04};
+	/** Free space: every n-th pixel in u and v is traced (Default: 4); surfaces use every pixel */
+	int freeRayStride{4};
+
+	bool isValid(std::string* error = nullptr) const;
+};
+
+/** Adds to `gt.seen` (sized on first use) what one noise-free depth image (CV_32FC1, metres
+ * along the optical axis, 0 = no return; pinhole `cam`, distortion ignored) taken at
+ * T_floor_cam (optical frame) shows of the plan: SeenSurface in the cell of every point inside
+ * [zMin, zMax] within maxRange (a point within 1 mm of a cell boundary marks both cells: plan
+ * surfaces lie on boundaries); SeenFreeSpace in every cell the ray's part inside the band
+ * crosses before the point's own cell (clipped at maxRange), and in the cell of a floor point.
+ * Throws std::invalid_argument on a depth image of the wrong type or size. */
+void markSeenCells(
+	FloorPlanGrid& gt, const cv::Mat& depth, const core::RgbdCamera& cam,
+	const mrpt::poses::CPose3D& T_floor_cam, const FloorPlanVisibilityOptions& opts = {});
 
 /** Resamples `src` (a grid in floor frame A) onto the lattice of `like` in floor frame B:
  * each output cell takes the state of the source cell under its centre (nearest neighbour),

@@ -1,0 +1,168 @@
+#include <keygrid/core/ProgressBar.h>
+#include <keygrid/core/TimestampAssociation.h>
+#include <keygrid/sim/GroundTruthOccupancy.h>
+#include <keygrid/sim/Renderer.h>
+#include <keygrid/sim/Scene.h>
+#include <keygrid/sim/SequenceWriter.h>
+#include <keygrid/slam/apps/MapEvaluation.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/io/vector_loadsave.h>
+#include <mrpt/system/filesystem.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+#include <stdexcept>
+
+namespace keygrid::slam
+{
+namespace
+{
+maps::FloorPlanGrid toFloorPlanGrid(const sim::FloorPlan& fp)
+{
+	maps::FloorPlanGrid g;
+	g.resolution = fp.resolution;
+	g.xMin = fp.origin.x();
+	g.yMin = fp.origin.y();
+	g.sizeX = fp.width;
+	g.sizeY = fp.height;
+	g.cells.resize(fp.occupied.size());
+	for (size_t i = 0; i < fp.occupied.size(); i++)
+		g.cells[i] = fp.occupied[i] ? maps::FloorPlanGrid::Occupied : maps::FloorPlanGrid::Free;
+	return g;
+}
+
+/** Renders the scene at the keyframes' ground-truth poses into gt.seen; returns how many. */
+std::size_t markVisibility(maps::FloorPlanGrid& gt, const MapEvaluationOptions& o, const core::Trajectory& gtTraj)
+{
+	if (!mrpt::system::fileExists(o.scenePath)) throw std::runtime_error("scene file '" + o.scenePath + "' does not exist");
+	const sim::Scene scene = sim::Scene::loadFromFile(o.scenePath);
+	maps::FloorPlanVisibilityOptions vis = o.visibility;
+	{
+		const mrpt::config::CConfigFileMemory cfg(mrpt::io::file_get_contents(o.scenePath));
+		sim::OutputOptions out;
+		if (cfg.sectionExists("output")) out.loadFromConfigFile(cfg, "output");
+		vis.zMin = out.floorPlanZMin;
+		vis.zMax = out.floorPlanZMax;
+	}
+	const core::Trajectory kfs = core::readTumTrajectory(o.keyframesPath);
+	std::vector<double> tk, tg;
+	for (const auto& k : kfs) tk.push_back(k.t);
+	for (const auto& g : gtTraj) tg.push_back(g.t);
+	const auto matches = core::associateTimestamps(tk, tg, o.maxDt);
+	if (matches.empty())
+		throw std::runtime_error(
+			"no keyframe of '" + o.keyframesPath + "' has a ground-truth pose within " + std::to_string(o.maxDt) + " s");
+	const sim::Renderer renderer(scene);
+	sim::RenderOutput view;
+	core::ProgressBar bar("visibility", matches.size(), o.progress);
+	std::size_t done = 0;
+	for (const auto& [ik, ig] : matches)
+	{
+		const auto& T_world_cam = gtTraj[ig].T_world_cam;
+		renderer.render(T_world_cam, gtTraj[ig].t - scene.options.startTime, view);
+		maps::markSeenCells(gt, view.depth, scene.camera, T_world_cam, vis);
+		bar.update(++done);
+	}
+	bar.finish();
+	return matches.size();
+}
+
+std::string num(double v)
+{
+	char b[64];
+	std::snprintf(b, sizeof(b), "%.6g", v);
+	return b;
+}
+}  // namespace
+
+MapEvaluationResult evaluateMapAgainstFloorPlan(
+	const MapEvaluationOptions& o, const mrpt::poses::CPose3D& T_gt_est, const core::Trajectory& gtTraj)
+{
+	if (o.mapYaml.empty() || o.floorPlanYaml.empty())
+		throw std::invalid_argument("map evaluation needs both a map and a floor plan");
+	if (o.scenePath.empty() != o.keyframesPath.empty())
+		throw std::invalid_argument("the visibility mask needs both a scene and a keyframes file");
+	for (const auto& p : {o.mapYaml, o.floorPlanYaml})
+		if (!mrpt::system::fileExists(p)) throw std::runtime_error("'" + p + "' does not exist");
+	maps::FloorPlanGrid gt = toFloorPlanGrid(sim::FloorPlan::load(o.floorPlanYaml));
+	const maps::TriStateGrid est = maps::TriStateGrid::loadRosMapServer(o.mapYaml);
+	if (!est.T_world_floor)
+		throw std::runtime_error(
+			"'" + o.mapYaml + "' has no '# keygrid T_world_floor' line (a map_2d.yaml written by keygrid-slam has it)");
+
+	MapEvaluationResult r;
+	const mrpt::poses::CPose3D T_gt_floor = T_gt_est + *est.T_world_floor;
+	r.floorOffset = T_gt_floor.z();
+	const auto R = T_gt_floor.getRotationMatrix();
+	r.floorTiltDeg = std::acos(std::min(1.0, std::abs(R(2, 2)))) * 180.0 / M_PI;
+
+	maps::TriStateGrid like;
+	like.resolution = gt.resolution;
+	like.xMin = gt.xMin;
+	like.yMin = gt.yMin;
+	like.sizeX = gt.sizeX;
+	like.sizeY = gt.sizeY;
+	const maps::TriStateGrid onPlan = maps::resampleTriState(est, T_gt_floor, like);
+
+	if (!o.scenePath.empty()) r.visibilityKeyframes = markVisibility(gt, o, gtTraj);
+	r.metrics = maps::evaluateOccupancy(onPlan, gt, o.metrics);
+	if (!o.overlayPath.empty())
+	{
+		const auto counts = maps::saveOverlayImage(o.overlayPath, onPlan, gt, o.metrics, o.overlay);
+		std::copy(counts.begin(), counts.end(), r.verdicts.begin());
+	}
+	else
+		for (const auto v : maps::classifyCells(onPlan, gt, o.metrics)) r.verdicts[static_cast<std::size_t>(v)]++;
+	return r;
+}
+
+std::string MapEvaluationResult::toText() const
+{
+	const auto& m = metrics;
+	char b[2048];
+	std::snprintf(
+		b, sizeof(b),
+		"map vs floor plan (%s):\n"
+		"  floor: estimated floor %+.4f m above the true one at its origin, tilted %.2f deg\n"
+		"  hazard cells %zu (interior obstacle cells called free, of %zu); obstacle cells called free %zu\n"
+		"  obstacle recall, boundary cells seen %.4f (%zu of %zu); all obstacle cells %.4f (%zu of %zu)\n"
+		"  obstacle precision %.4f (%zu of %zu)\n"
+		"  free space F1 %.4f: precision %.4f (%zu of %zu), recall %.4f (%zu of %zu %s)\n",
+		visibilityKeyframes ? ("visibility from " + std::to_string(visibilityKeyframes) + " keyframes").c_str()
+							: "no visibility mask: every cell counts as seen",
+		floorOffset, floorTiltDeg, m.hazardCells, m.gtOccupiedInterior, m.gtOccupiedCalledFree, m.boundaryRecall,
+		m.gtBoundarySeenMatched, m.gtBoundarySeen, m.recall, m.gtOccupiedMatched, m.gtOccupied, m.precision,
+		m.estOccupiedMatched, m.estOccupied, m.freeF1, m.freePrecision, m.estFreeCorrect, m.estFree, m.freeRecall,
+		m.gtFreeSeenCalledFree, m.gtFreeSeen, visibilityKeyframes ? "free cells in view" : "free cells");
+	std::ostringstream o;
+	o << b << "  cells:";
+	for (int i = 0; i < maps::kCellVerdictCount; i++)
+		o << (i ? ", " : " ") << maps::cellVerdictName(static_cast<maps::CellVerdict>(i)) << " " << verdicts[i];
+	o << "\n";
+	return o.str();
+}
+
+std::string MapEvaluationResult::jsonFields() const
+{
+	const auto& m = metrics;
+	std::ostringstream o;
+	o << "  \"map_hazard_cells\": " << m.hazardCells << ",\n"
+	  << "  \"map_interior_obstacle_cells\": " << m.gtOccupiedInterior << ",\n"
+	  << "  \"map_obstacle_called_free_cells\": " << m.gtOccupiedCalledFree << ",\n"
+	  << "  \"map_boundary_recall\": " << num(m.boundaryRecall) << ",\n"
+	  << "  \"map_boundary_cells_seen\": " << m.gtBoundarySeen << ",\n"
+	  << "  \"map_obstacle_precision\": " << num(m.precision) << ",\n"
+	  << "  \"map_obstacle_recall\": " << num(m.recall) << ",\n"
+	  << "  \"map_free_precision\": " << num(m.freePrecision) << ",\n"
+	  << "  \"map_free_recall\": " << num(m.freeRecall) << ",\n"
+	  << "  \"map_free_f1\": " << num(m.freeF1) << ",\n"
+	  << "  \"map_free_cells_seen\": " << m.gtFreeSeen << ",\n"
+	  << "  \"map_floor_offset_m\": " << num(floorOffset) << ",\n"
+	  << "  \"map_floor_tilt_deg\": " << num(floorTiltDeg) << ",\n"
+	  << "  \"map_visibility_keyframes\": " << visibilityKeyframes;
+	return o.str();
+}
+
+}  // namespace keygrid::slam
