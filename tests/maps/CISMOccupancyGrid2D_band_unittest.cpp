@@ -29,6 +29,7 @@ CISMOccupancyGrid2D makeGrid(Model model)
 	grid.insertionOptions.freeSpaceModel = model;
 	grid.insertionOptions.rangeNoise = keygrid::maps::RangeNoiseModel::Constant;
 	grid.insertionOptions.sigmaConstant = 0.01;
+	grid.insertionOptions.depthDecimation = 1;  // the images are 160 x 120
 	return grid;
 }
 

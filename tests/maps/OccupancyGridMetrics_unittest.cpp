@@ -278,21 +278,23 @@ TEST(OccupancyGridMetrics, SeenCellsOfAHandMadeDepthColumn)
 	o.freeRayStride = 1;
 	FloorPlanGrid g = emptyPlan();
 	markSeenCells(g, depth, columnCamera(), lookingAlongX(0.25, 0.25, 1.0), o);
-	EXPECT_EQ(seenRow(g, 0), "2222221000");  // 2 = SeenFreeSpace, 1 = SeenSurface
+	// 2 = SeenFreeSpace, 1 = SeenSurface, 4 = SeenFloor: the floor ray is below the band
+	// (z < 0.1) only over its last 0.1 m, x = 1.15..1.25, all in cell 2.
+	EXPECT_EQ(seenRow(g, 0), "2262221000");
 	for (int cy = 1; cy < 4; cy++) EXPECT_EQ(seenRow(g, cy), "0000000000") << cy;
 
 	// 2 m range: the wall is out of range, free space ends at x = 0.25 + 2 = 2.25 (cell 4).
 	o.maxRange = 2.0;
 	g = emptyPlan();
 	markSeenCells(g, depth, columnCamera(), lookingAlongX(0.25, 0.25, 1.0), o);
-	EXPECT_EQ(seenRow(g, 0), "2222200000");
+	EXPECT_EQ(seenRow(g, 0), "2262200000");
 
 	// A wall exactly on the boundary x = 3.0 marks both cells' surfaces; free up to cell 5.
 	o.maxRange = 4.5;
 	depth.at<float>(1) = 2.75f;
 	g = emptyPlan();
 	markSeenCells(g, depth, columnCamera(), lookingAlongX(0.25, 0.25, 1.0), o);
-	EXPECT_EQ(seenRow(g, 0), "2222231000");  // cell 5: both bits
+	EXPECT_EQ(seenRow(g, 0), "2262231000");  // cell 5: both bits
 
 	// A camera above the band sees nothing of it along a level ray.
 	cv::Mat level(3, 1, CV_32FC1, cv::Scalar(0.0f));

@@ -25,6 +25,13 @@ bool FloorPlanGrid::inView(int cx, int cy) const
 	return (seen[static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX] & bit) != 0;
 }
 
+bool FloorPlanGrid::floorInView(int cx, int cy) const
+{
+	if (seen.empty()) return true;
+	if (cell(cx, cy) == Ignore) return false;
+	return (seen[static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX] & SeenFloor) != 0;
+}
+
 bool OccupancyMetricsOptions::isValid(std::string* error) const
 {
 	std::string why;
@@ -215,6 +222,11 @@ OccupancyMetrics evaluate(const EstView& est, const FloorPlanGrid& gt, const Occ
 					m.gtFreeSeen++;
 					if (s == CellState::Free) m.gtFreeSeenCalledFree++;
 				}
+				if (gt.floorInView(cx, cy))
+				{
+					m.gtFreeFloorSeen++;
+					if (s == CellState::Free) m.gtFreeFloorSeenCalledFree++;
+				}
 				if (s == CellState::Unknown) continue;
 				m.gtFreeObserved++;
 				if (s == CellState::Free) m.gtFreeCorrect++;
@@ -237,6 +249,8 @@ OccupancyMetrics evaluate(const EstView& est, const FloorPlanGrid& gt, const Occ
 	m.boundaryRecall = ratio(m.gtBoundarySeenMatched, m.gtBoundarySeen);
 	m.freeRecall = ratio(m.gtFreeSeenCalledFree, m.gtFreeSeen);
 	m.freeF1 = harmonic(m.freePrecision, m.freeRecall);
+	m.freeRecallFloorSeen = ratio(m.gtFreeFloorSeenCalledFree, m.gtFreeFloorSeen);
+	m.freeF1FloorSeen = harmonic(m.freePrecision, m.freeRecallFloorSeen);
 	return m;
 }
 }  // namespace

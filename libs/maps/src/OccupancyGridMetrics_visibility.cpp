@@ -76,7 +76,28 @@ class SeenMarker
 				return true;
 			});
 		}
-		if (floor && h <= m_o.maxRange) mark(pcx, pcy, FloorPlanGrid::SeenFreeSpace);
+		if (floor && h <= m_o.maxRange) mark(pcx, pcy, static_cast<uint8_t>(FloorPlanGrid::SeenFreeSpace | FloorPlanGrid::SeenFloor));
+		// The ray's part below the band: the floor-level space of the cells it crosses.
+		double f0 = 0, f1 = 1;
+		if (std::abs(dz) < 1e-12)
+		{
+			if (c.z >= m_o.zMin) f1 = -1;
+		}
+		else if (dz < 0)
+			f0 = std::max(0.0, (m_o.zMin - c.z) / dz);
+		else
+			f1 = std::min(1.0, (m_o.zMin - c.z) / dz);
+		if (h > 0) f1 = std::min(f1, m_o.maxRange / h);
+		if (f0 < f1)
+		{
+			const double half = 0.5 * m_gt.resolution;
+			const mrpt::math::TPoint3D a(c.x + f0 * (p.x - c.x) - m_gt.xMin, c.y + f0 * (p.y - c.y) - m_gt.yMin, half);
+			const mrpt::math::TPoint3D b(c.x + f1 * (p.x - c.x) - m_gt.xMin, c.y + f1 * (p.y - c.y) - m_gt.yMin, half);
+			traverseSegment(a, b, m_gt.resolution, [&](const VoxelIndex& v) {
+				if (floor || v.x != pcx || v.y != pcy) mark(v.x, v.y, FloorPlanGrid::SeenFloor);
+				return true;
+			});
+		}
 	}
 
    private:

@@ -129,13 +129,15 @@ std::string MapEvaluationResult::toText() const
 		"  hazard cells %zu (interior obstacle cells called free, of %zu); obstacle cells called free %zu\n"
 		"  obstacle recall, boundary cells seen %.4f (%zu of %zu); all obstacle cells %.4f (%zu of %zu)\n"
 		"  obstacle precision %.4f (%zu of %zu)\n"
-		"  free space F1 %.4f: precision %.4f (%zu of %zu), recall %.4f (%zu of %zu %s)\n",
+		"  free space F1 %.4f: precision %.4f (%zu of %zu), recall %.4f (%zu of %zu %s)\n"
+		"  free space F1 over the cells whose floor was in view %.4f: recall %.4f (%zu of %zu)\n",
 		visibilityKeyframes ? ("visibility from " + std::to_string(visibilityKeyframes) + " keyframes").c_str()
 							: "no visibility mask: every cell counts as seen",
 		floorOffset, floorTiltDeg, m.hazardCells, m.gtOccupiedInterior, m.gtOccupiedCalledFree, m.boundaryRecall,
 		m.gtBoundarySeenMatched, m.gtBoundarySeen, m.recall, m.gtOccupiedMatched, m.gtOccupied, m.precision,
 		m.estOccupiedMatched, m.estOccupied, m.freeF1, m.freePrecision, m.estFreeCorrect, m.estFree, m.freeRecall,
-		m.gtFreeSeenCalledFree, m.gtFreeSeen, visibilityKeyframes ? "free cells in view" : "free cells");
+		m.gtFreeSeenCalledFree, m.gtFreeSeen, visibilityKeyframes ? "free cells in view" : "free cells",
+		m.freeF1FloorSeen, m.freeRecallFloorSeen, m.gtFreeFloorSeenCalledFree, m.gtFreeFloorSeen);
 	std::ostringstream o;
 	o << b << "  cells:";
 	for (int i = 0; i < maps::kCellVerdictCount; i++)
@@ -159,6 +161,9 @@ std::string MapEvaluationResult::jsonFields() const
 	  << "  \"map_free_recall\": " << num(m.freeRecall) << ",\n"
 	  << "  \"map_free_f1\": " << num(m.freeF1) << ",\n"
 	  << "  \"map_free_cells_seen\": " << m.gtFreeSeen << ",\n"
+	  << "  \"map_free_recall_floor_seen\": " << num(m.freeRecallFloorSeen) << ",\n"
+	  << "  \"map_free_f1_floor_seen\": " << num(m.freeF1FloorSeen) << ",\n"
+	  << "  \"map_free_cells_floor_seen\": " << m.gtFreeFloorSeen << ",\n"
 	  << "  \"map_floor_offset_m\": " << num(floorOffset) << ",\n"
 	  << "  \"map_floor_tilt_deg\": " << num(floorTiltDeg) << ",\n"
 	  << "  \"map_visibility_keyframes\": " << visibilityKeyframes;

@@ -36,8 +36,12 @@ struct FloorPlanGrid
 	/** Bits of `seen`. */
 	enum SeenBits : uint8_t
 	{
-		SeenSurface = 1,   ///< a surface point inside the height band was seen in the cell
-		SeenFreeSpace = 2  ///< a ray crossed the cell's column inside the band, or ended on its floor
+		SeenSurface = 1,    ///< a surface point inside the height band was seen in the cell
+		SeenFreeSpace = 2,  ///< a ray crossed the cell's column inside the band, or ended on its floor
+		/** A ray crossed the cell's column below the band (zMin), or ended on its floor: the base
+		 * of anything standing there was in view, the condition for calling a cell free without
+		 * ever missing a low obstacle */
+		SeenFloor = 4
 	};
 	double resolution{0.05};
 	double xMin{0}, yMin{0};
@@ -57,6 +61,9 @@ struct FloorPlanGrid
 	}
 	/** Whether the cameras saw cell (cx, cy) in the sense of its class (true without a mask). */
 	bool inView(int cx, int cy) const;
+	/** Whether the cameras saw the floor-level space of cell (cx, cy) (SeenFloor; true without
+	 * a mask). */
+	bool floorInView(int cx, int cy) const;
 };
 
 struct OccupancyMetricsOptions
@@ -111,6 +118,10 @@ struct OccupancyMetrics
 	double freeRecall{0};
 	/** Harmonic mean of freePrecision and freeRecall. */
 	double freeF1{0};
+	/** The same recall and F1 over the GT-free cells whose floor-level space was in view
+	 * (SeenFloor): the free space a map can certify without risking a low obstacle. */
+	size_t gtFreeFloorSeen{0}, gtFreeFloorSeenCalledFree{0};
+	double freeRecallFloorSeen{0}, freeF1FloorSeen{0};
 };
 
 /** What a floor-plan cell is, comparing the estimate with the ground truth (the overlay's
@@ -216,7 +227,8 @@ struct FloorPlanVisibilityOptions
  * T_floor_cam (optical frame) shows of the plan: SeenSurface in the cell of every point inside
  * [zMin, zMax] within maxRange (a point within 1 mm of a cell boundary marks both cells: plan
  * surfaces lie on boundaries); SeenFreeSpace in every cell the ray's part inside the band
- * crosses before the point's own cell (clipped at maxRange), and in the cell of a floor point.
+ * crosses before the point's own cell (clipped at maxRange), and in the cell of a floor point;
+ * SeenFloor likewise for the ray's part below zMin.
  * Throws std::invalid_argument on a depth image of the wrong type or size. */
 void markSeenCells(
 	FloorPlanGrid& gt, const cv::Mat& depth, const core::RgbdCamera& cam,
