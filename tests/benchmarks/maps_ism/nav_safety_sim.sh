@@ -6,11 +6,13 @@
 # keyframes' ground-truth poses). One table row per (scene, model, input):
 #   hazard cells (interior obstacle cells called free; 0 = navigation-safe), obstacle recall over
 #   the boundary cells the cameras saw, obstacle precision, free-space F1 (precision / recall over
-#   the free cells in view), floor error of the estimate (height at its origin / tilt), ATE.
+#   the free cells in view, and recall over the free cells whose floor-level space was in view),
+#   floor error of the estimate (height at its origin / tilt), ATE.
 # Definitions: doc/maps-ism2d.md "Navigation safety". Uses shipped tools only.
 #
 #   tests/benchmarks/maps_ism/nav_safety_sim.sh [--build DIR] [--out DIR] [--scenes "room_loop ..."]
 #       [--models "heightBand paper"] [--inputs "sparse dense"] [--max-frames N] [--sim-frames N]
+#       [--set 'SECTION.KEY=V; ...'] [--tag NAME]
 #
 #   --build DIR        build tree with bin/keygrid-sim, keygrid-slam, keygrid-eval (default: build)
 #   --out DIR          renders (kept and reused) and runs (redone every time) (default:
@@ -22,6 +24,8 @@
 #   --max-frames N     keygrid-slam stops after N frames (the render stays complete) (default: all)
 #   --sim-frames N     render N frames instead of the scene's count: keygrid-sim --frames, the same
 #                      walk stretched to N frames, i.e. a faster camera (default: the scene's)
+#   --set OVERRIDES    more keygrid-slam --set overrides for every run (default: none)
+#   --tag NAME         suffix of the run folders, to keep runs with other --set apart (default: none)
 #
 # The model is passed as --set 'MappingApplication_ismOccupancyGrid2D_00_insertOpts.freeSpaceModel=M'.
 # A keygrid-slam that does not know the key (before issue 26's grid) rejects it; the script then
@@ -36,6 +40,8 @@ models="heightBand paper"
 inputs="sparse dense"
 maxFrames=0
 simFrames=0
+extraSet=""
+runTag=""
 die() { echo "nav_safety_sim.sh: error: $*" >&2; exit 2; }
 while [ $# -gt 0 ]; do
   [ $# -ge 2 ] || { [ "$1" = --help ] || [ "$1" = -h ] || die "missing value after $1"; }
@@ -47,6 +53,8 @@ while [ $# -gt 0 ]; do
     --inputs) inputs="$2" ;;
     --max-frames) maxFrames="$2" ;;
     --sim-frames) simFrames="$2" ;;
+    --set) extraSet="$2" ;;
+    --tag) runTag="_$2" ;;
     --help|-h) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) die "unknown argument $1 (see --help)" ;;
   esac
@@ -62,7 +70,9 @@ for s in $scenes; do [ -f "$root/config/sim/$s.ini" ] || die "--scenes: no scene
 mkdir -p "$out"
 
 section=MappingApplication_ismOccupancyGrid2D_00_insertOpts
-if "$bin/keygrid-slam" --ini-reference | grep -q freeSpaceModel; then haveModel=1; else
+# (the reference is read whole first: grep -q would close the pipe early, and pipefail would see
+# keygrid-slam's SIGPIPE)
+if grep -q freeSpaceModel <<< "$("$bin/keygrid-slam" --ini-reference)"; then haveModel=1; else
   haveModel=0
   echo "note: this keygrid-slam has no $section.freeSpaceModel: 'paper' runs without the key (today's grid), other models n/a"
 fi
@@ -80,11 +90,11 @@ render() {
   echo "$sum" > "$dir/.complete"
 }
 
-row() { printf '| %-14s | %-10s | %-6s | %11s | %-6s | %-12s | %-15s | %-23s | %-18s | %8s |\n' "$@"; }
+row() { printf '| %-14s | %-10s | %-6s | %11s | %-6s | %-12s | %-15s | %-23s | %-14s | %-18s | %8s |\n' "$@"; }
 table=$(mktemp)
 {
-  row scene model input "hazard" "of" "obst. recall" "obst. precision" "free F1 (P / R)" "floor dz / tilt" "ATE"
-  echo "|---|---|---|---|---|---|---|---|---|---|"
+  row scene model input "hazard" "of" "obst. recall" "obst. precision" "free F1 (P / R)" "floor seen: F1 / R" "floor dz / tilt" "ATE"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|"
 } > "$table"
 
 tag=""; [ "$simFrames" -gt 0 ] && tag="_f$simFrames"
@@ -93,8 +103,9 @@ for scene in $scenes; do
   if ! render "$scene" "$sim"; then row "$scene" - - "render failed" "" "" "" "" "" "" >> "$table"; continue; fi
   for model in $models; do
     for input in $inputs; do
-      run="$out/run/$scene${tag}_${model}_${input}"; [ "$maxFrames" -gt 0 ] && run="${run}_m$maxFrames"
+      run="$out/run/$scene${tag}_${model}_${input}${runTag}"; [ "$maxFrames" -gt 0 ] && run="${run}_m$maxFrames"
       overrides="maps.ism2d_input=$input"
+      [ -n "$extraSet" ] && overrides="$overrides; $extraSet"
       if [ "$haveModel" = 1 ]; then overrides="$overrides; $section.freeSpaceModel=$model"
       elif [ "$model" != paper ]; then row "$scene" "$model" "$input" "n/a" "" "" "" "(no freeSpaceModel key)" "" "" >> "$table"; continue
       fi
@@ -116,6 +127,7 @@ e = json.load(open(sys.argv[1]))
 print("\t".join([str(e["map_hazard_cells"]), str(e["map_interior_obstacle_cells"]),
     f"{e['map_boundary_recall']:.3f}", f"{e['map_obstacle_precision']:.3f}",
     f"{e['map_free_f1']:.3f} ({e['map_free_precision']:.3f} / {e['map_free_recall']:.3f})",
+    f"{e['map_free_f1_floor_seen']:.3f} / {e['map_free_recall_floor_seen']:.3f}",
     f"{100 * e['map_floor_offset_m']:+.1f} cm / {e['map_floor_tilt_deg']:.2f} deg", f"{100 * e['ate_rmse_m']:.2f} cm"]))
 PY
 )
@@ -126,7 +138,8 @@ done
 echo
 echo "keygrid-slam config/sim.ini, map_2d vs floorplan (5 cm cells, 1-cell tolerance); hazard = interior"
 echo "obstacle cells called free; recall over the obstacle boundary cells seen from the keyframes;"
-echo "free F1 over the free cells in view; floor = estimated floor in the ground-truth world."
-echo "Overlays: $out/run/<scene>_<model>_<input>/overlay.png"
+echo "free F1 over the free cells in view, and over those whose floor-level space was in view;"
+echo "floor = estimated floor in the ground-truth world."
+echo "Overlays: $out/run/<scene>_<model>_<input>$runTag/overlay.png"
 cat "$table"
 rm -f "$table"
