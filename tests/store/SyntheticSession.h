@@ -33,7 +33,7 @@ inline store::KeyFrameRecord syntheticKeyFrame(store::KeyFrameId id, int numKeyp
 	for (int l = 0; l < kf.numLevels; l++) kf.levelScale.push_back(std::pow(1.2, l));
 	const auto n = static_cast<std::size_t>(numKeypoints);
 	kf.descriptors = cv::Mat(numKeypoints, 32, CV_8U);
-	cv::RNG(seed * 7919 + id).fill(kf.descriptors, cv::RNG::UNIFORM, 0, 256);
+	if (numKeypoints > 0) cv::RNG(seed * 7919 + id).fill(kf.descriptors, cv::RNG::UNIFORM, 0, 256);
 	for (std::size_t i = 0; i < n; i++)
 	{
 		const int octave = static_cast<int>(u(rng) * 8);
