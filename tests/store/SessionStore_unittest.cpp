@@ -342,6 +342,7 @@ TEST(SessionStore, DamagedFileIsRefused)
 	const std::string err = openError(path);
 	EXPECT_NE(err.find(path), std::string::npos) << err;
 	EXPECT_NE(err.find("is damaged"), std::string::npos) << err;
+	EXPECT_THROW(SessionStore::Check(path), std::runtime_error);
 
 	// A file cut short.
 	const std::string cut = test::scratchDir("store_truncated") + "/session.kgmap";
@@ -358,6 +359,7 @@ TEST(SessionStoreOptions, IniRoundTripAndErrorsNameTheKey)
 	o.durability = "normal";
 	o.cacheSizeKiB = 4096;
 	o.busyTimeoutMs = 100;
+	o.integrityCheck = "none";
 	mrpt::config::CConfigFileMemory ini;
 	o.saveToConfigFile(ini, "store");
 	SessionStoreOptions back;
@@ -365,6 +367,7 @@ TEST(SessionStoreOptions, IniRoundTripAndErrorsNameTheKey)
 	EXPECT_EQ(back.durability, "normal");
 	EXPECT_EQ(back.cacheSizeKiB, 4096);
 	EXPECT_EQ(back.busyTimeoutMs, 100);
+	EXPECT_EQ(back.integrityCheck, "none");
 	ini.write("store", "durability", "sometimes");
 	try
 	{

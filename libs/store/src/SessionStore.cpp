@@ -110,9 +110,9 @@ void validateOptions(const SessionStoreOptions& opts)
 	if (!opts.isValid(&why)) throw std::invalid_argument("SessionStoreOptions: " + why);
 }
 
-/** Application id, schema version and SQLite's structural check, in that order (the first
- * two are one page read each; quick_check reads the whole file). */
-void checkOpenedFile(detail::SqliteDb& db)
+/** Application id, schema version and (when quickCheck) SQLite's structural check, in that
+ * order (the first two are one page read each; quick_check reads the whole file). */
+void checkOpenedFile(detail::SqliteDb& db, bool quickCheck)
 {
 	const std::string& path = db.path();
 	std::int64_t appId = 0;
@@ -148,6 +148,7 @@ void checkOpenedFile(detail::SqliteDb& db)
 		throw std::runtime_error("'" + path + "' has session schema version " + (version.empty() ? "(none)" : version) +
 								 "; this keygrid (" KEYGRID_VERSION_STRING ") reads version " +
 								 std::to_string(SessionStore::kSchemaVersion));
+	if (!quickCheck) return;
 	std::string check;
 	try
 	{
@@ -338,14 +339,19 @@ SessionStore SessionStore::Open(const std::string& path, Mode mode, const Sessio
 	const int flags = (writable ? SQLITE_OPEN_READWRITE : SQLITE_OPEN_READONLY) | SQLITE_OPEN_NOMUTEX;
 	auto impl = std::make_unique<Impl>(path, flags, mode);
 	sqlite3_busy_timeout(impl->db.handle(), opts.busyTimeoutMs);
-	checkOpenedFile(impl->db);
+	checkOpenedFile(impl->db, opts.integrityCheck == "quick");
 	applyPragmas(impl->db, opts, writable);
 	impl->loadMeta();
 	impl->loadCameras();
 	return SessionStore(std::move(impl));
 }
 
-void SessionStore::Check(const std::string& path) { Open(path, Mode::ReadOnly); }
+void SessionStore::Check(const std::string& path)
+{
+	SessionStoreOptions opts;
+	opts.integrityCheck = "quick";
+	Open(path, Mode::ReadOnly, opts);
+}
 
 const std::string& SessionStore::path() const { return m_impl->db.path(); }
 const SessionMeta& SessionStore::meta() const { return m_impl->meta; }

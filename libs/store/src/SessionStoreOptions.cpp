@@ -15,6 +15,8 @@ bool SessionStoreOptions::isValid(std::string* error) const
 	if (durability != "full" && durability != "normal") return bad("durability must be full or normal, got '" + durability + "'");
 	if (cacheSizeKiB < 64) return bad("cache_size_kib must be >= 64, got " + std::to_string(cacheSizeKiB));
 	if (busyTimeoutMs < 0) return bad("busy_timeout_ms must be >= 0, got " + std::to_string(busyTimeoutMs));
+	if (integrityCheck != "quick" && integrityCheck != "none")
+		return bad("integrity_check must be quick or none, got '" + integrityCheck + "'");
 	return true;
 }
 
@@ -23,6 +25,7 @@ void SessionStoreOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase
 	durability = cfg.read_string(section, "durability", durability);
 	cacheSizeKiB = static_cast<int>(core::readFiniteNumber(cfg, section, "cache_size_kib", cacheSizeKiB));
 	busyTimeoutMs = static_cast<int>(core::readFiniteNumber(cfg, section, "busy_timeout_ms", busyTimeoutMs));
+	integrityCheck = cfg.read_string(section, "integrity_check", integrityCheck);
 	std::string why;
 	if (!isValid(&why)) throw std::invalid_argument("[" + section + "] " + why);
 }
@@ -32,6 +35,7 @@ void SessionStoreOptions::saveToConfigFile(mrpt::config::CConfigFileBase& cfg, c
 	cfg.write(section, "durability", durability);
 	cfg.write(section, "cache_size_kib", cacheSizeKiB);
 	cfg.write(section, "busy_timeout_ms", busyTimeoutMs);
+	cfg.write(section, "integrity_check", integrityCheck);
 }
 
 }  // namespace keygrid::store

@@ -12,9 +12,9 @@
  *   full), flushed outside the timing.
  * - BM_EncodeImages/colour: KeyFrameImageCodec::encode of a 640x480 grey (0) or BGR (1) image
  *   and its 16-bit depth (PNG level 1); BM_DecodeImages: loading them back by id.
- * - BM_LoadSession/N: Open() (application id, version, quick_check) + every keyframe without
- *   images, landmark, covisibility edge and loop constraint of an N-keyframe session with
- *   images; BM_OpenSession/N: Open() alone.
+ * - BM_LoadSession/N/quick_check: Open() (application id, version, quick_check when 1) + every
+ *   keyframe without images, landmark, covisibility edge and loop constraint of an N-keyframe
+ *   session with images; BM_OpenSession/N: Open() alone (with quick_check).
  * Images are TUM fr1_desk's first frame when ../shared/data is present, else synthetic.
  * Stores are written under $TMPDIR (default /tmp).
  * Run: <build>/bin/keygrid_bench_store
@@ -114,6 +114,10 @@ SessionUpdate keyframeUpdate(KeyFrameId id, const EncodedImages* images)
 	u.keyframes.push_back(keyframeData().kf);
 	u.keyframes.back().id = id;
 	u.keyframes.back().frameIndex = 10 * id;
+	// Keypoint k < 100 observes the keyframe's new landmark k (as the landmarks below say).
+	auto& lmOfKp = u.keyframes.back().landmarks;
+	std::fill(lmOfKp.begin(), lmOfKp.end(), kNoLandmark);
+	for (std::size_t k = 0; k < 100 && k < lmOfKp.size(); k++) lmOfKp[k] = id * 1000 + k;
 	if (images) u.images.push_back(*images);
 	for (int k = 0; k < 100; k++)
 	{
@@ -246,10 +250,12 @@ fs::path sessionOf(int n)
 void BM_LoadSession(benchmark::State& state)
 {
 	const fs::path path = sessionOf(static_cast<int>(state.range(0)));
+	SessionStoreOptions opts;
+	opts.integrityCheck = state.range(1) ? "quick" : "none";
 	std::size_t kfs = 0, lms = 0;
 	for (auto _ : state)
 	{
-		const auto store = SessionStore::Open(path.string());
+		const auto store = SessionStore::Open(path.string(), SessionStore::Mode::ReadOnly, opts);
 		const auto k = store.loadKeyFrames();
 		const auto l = store.loadLandmarks();
 		const auto c = store.loadCovisibility();
@@ -263,7 +269,7 @@ void BM_LoadSession(benchmark::State& state)
 	state.counters["landmarks"] = static_cast<double>(lms);
 	state.counters["file_MiB"] = static_cast<double>(fs::file_size(path)) / (1024.0 * 1024.0);
 }
-BENCHMARK(BM_LoadSession)->Arg(100)->Arg(400)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_LoadSession)->ArgsProduct({{100, 400}, {1, 0}})->ArgNames({"keyframes", "quick_check"})->Unit(benchmark::kMillisecond);
 
 void BM_OpenSession(benchmark::State& state)
 {

@@ -39,11 +39,13 @@ class SessionStore
 	static SessionStore Create(
 		const std::string& path, const SessionMeta& meta, const SessionStoreOptions& opts = {});
 	/** Opens an existing session. Throws std::runtime_error naming the file and the reason when
-	 * it does not exist, is not an SQLite database, is not a keygrid session, fails SQLite's
-	 * integrity check (`PRAGMA quick_check`), or has another schema version (naming both). */
+	 * it does not exist, is not an SQLite database, is not a keygrid session, has another schema
+	 * version (naming both), or fails SQLite's integrity check (`PRAGMA quick_check`, unless
+	 * opts.integrityCheck = "none"). */
 	static SessionStore Open(
 		const std::string& path, Mode mode = Mode::ReadOnly, const SessionStoreOptions& opts = {});
-	/** Runs the checks of Open() without keeping the file open; throws like Open(). */
+	/** Runs every check of Open(), quick_check included, without keeping the file open; throws
+	 * like Open(). */
 	static void Check(const std::string& path);
 
 	SessionStore(SessionStore&&) noexcept;

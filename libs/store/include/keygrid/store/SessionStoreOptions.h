@@ -25,10 +25,15 @@ struct SessionStoreOptions
 	int cacheSizeKiB{8192};
 	/** How long a statement waits for a lock held by another connection [ms] (Default: 5000) */
 	int busyTimeoutMs{5000};
+	/** What Open() checks beyond application id and schema version: "quick" runs SQLite's
+	 * `PRAGMA quick_check`, which reads every page of the file (images included); "none" skips
+	 * it, for large sessions on slow storage (SessionStore::Check always runs it)
+	 * (Default: quick) */
+	std::string integrityCheck{"quick"};
 
 	/** Returns false and the offending key and value in *error when invalid. */
 	bool isValid(std::string* error = nullptr) const;
-	/** Keys durability, cache_size_kib, busy_timeout_ms; missing keys keep their value; an
+	/** Keys durability, cache_size_kib, busy_timeout_ms, integrity_check; missing keys keep their value; an
 	 * invalid value throws std::invalid_argument naming the key. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
