@@ -3,7 +3,8 @@
  * every commit through a pipe; the parent SIGKILLs it at a random moment of the write after the
  * N-th commit, reopens the file and checks that it holds keyframes 0..M-1 (M >= N), each with
  * everything its transaction wrote: record, images, new and updated landmarks, the pose update
- * of its predecessor, its covisibility edge, loop constraints and map snapshot.
+ * of its predecessor, its covisibility edge, loop constraints and map snapshot; then that the
+ * session can be extended from there.
  */
 #include <keygrid/store/KeyFrameImageCodec.h>
 #include <keygrid/store/SessionStore.h>
@@ -182,5 +183,12 @@ TEST(SessionStoreCrash, SigkillLeavesEveryCommittedKeyFrameComplete)
 		EXPECT_GE(M, N);
 		EXPECT_GE(M, committed) << "every reported commit is in the file";
 		EXPECT_LE(M, committed + 1) << "at most the write under way when killed committed unreported";
+
+		// The session can be extended where the killed writer stopped.
+		{
+			auto store = SessionStore::Open(path, SessionStore::Mode::ReadWrite);
+			store.write(updateFor(M, images));
+		}
+		EXPECT_EQ(checkConsistent(path, images), M + 1);
 	}
 }

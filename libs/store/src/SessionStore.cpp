@@ -313,12 +313,13 @@ SessionStore SessionStore::Create(const std::string& path, const SessionMeta& me
 	if (std::filesystem::exists(path))
 		throw std::runtime_error("SessionStore::Create: '" + path + "' already exists (open it to extend it, or remove it)");
 	auto impl = std::make_unique<Impl>(path, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOMUTEX, Mode::ReadWrite);
-	applyPragmas(impl->db, opts, true);
-	impl->meta = meta;
-	impl->meta.schemaVersion = kSchemaVersion;
-	impl->meta.keygridVersion = KEYGRID_VERSION_STRING;
-	impl->meta.createdUtc = nowUtcIso();
+	try
 	{
+		applyPragmas(impl->db, opts, true);
+		impl->meta = meta;
+		impl->meta.schemaVersion = kSchemaVersion;
+		impl->meta.keygridVersion = KEYGRID_VERSION_STRING;
+		impl->meta.createdUtc = nowUtcIso();
 		detail::SqliteTransaction tx(impl->db);
 		impl->db.exec(kSchemaV1);
 		impl->db.exec("PRAGMA application_id = " + std::to_string(kApplicationId));
@@ -326,6 +327,14 @@ SessionStore SessionStore::Create(const std::string& path, const SessionMeta& me
 		impl->writeMeta();
 		impl->cameraId(impl->meta.camera);
 		tx.commit();
+	}
+	catch (...)
+	{
+		// A file without its schema is no session: do not leave it behind.
+		impl.reset();
+		std::error_code ec;
+		for (const char* suffix : {"", "-wal", "-shm"}) std::filesystem::remove(path + suffix, ec);
+		throw;
 	}
 	return SessionStore(std::move(impl));
 }

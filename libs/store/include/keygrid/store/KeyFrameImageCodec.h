@@ -1,8 +1,8 @@
 #pragma once
 /** \file KeyFrameImageCodec.h
  * Compresses a keyframe's colour and depth images for the session store and back. Encoding is
- * the costly part of storing a keyframe (a 640x480 PNG takes milliseconds), so it is separate
- * from SessionStore::write(): run it on another thread and hand the EncodedImages over.
+ * the costly part of storing a keyframe, so it is separate from SessionStore::write(): run it on
+ * another thread (SessionWriter does) and hand the EncodedImages over.
  */
 #include <keygrid/store/SessionRecords.h>
 
@@ -17,7 +17,7 @@ namespace keygrid::store
 {
 struct ImageCodecOptions
 {
-	/** Colour image format: "png" (lossless) or "jpg" (lossy, ~10x smaller) (Default: png) */
+	/** Colour image format: "png" (lossless) or "jpg" (lossy, much smaller) (Default: png) */
 	std::string colourFormat{"png"};
 	/** zlib level of the PNGs, 0 (none) .. 9 (smallest, slowest); the depth PNG always uses it
 	 * too (Default: 1, the fastest level that compresses) */
