@@ -7,6 +7,8 @@
 #include <keygrid/store/SparseMapRecords.h>
 #include <keygrid/store/VocabularyFingerprint.h>
 
+#include <sstream>
+
 #include "StoreTestHelpers.h"
 #include "SyntheticSession.h"
 #include "TestData.h"
@@ -92,4 +94,51 @@ TEST(VocabularyFingerprint, FileAndObjectGiveTheSameIdentity)
 	o.seed = 2;
 	EXPECT_NE(vocabularyIdentity(loop::Vocabulary::train(images, o), "small_voc.bin").hash, a.hash);
 	EXPECT_THROW(vocabularyIdentityOfFile(path + ".missing"), std::runtime_error);
+}
+
+TEST(VocabularyFingerprint, AVocabularyStoredInTheSessionComesBackWithItsIdentity)
+{
+	std::vector<cv::Mat> images;
+	for (int i = 0; i < 3; i++)
+	{
+		cv::Mat d(150, 32, CV_8U);
+		cv::RNG(10 + i).fill(d, cv::RNG::UNIFORM, 0, 256);
+		images.push_back(d);
+	}
+	loop::VocabularyOptions o;
+	o.branching = 3;
+	o.levels = 2;
+	o.threads = 1;
+	const auto voc = loop::Vocabulary::train(images, o);
+	const std::string path = test::scratchDir("store_vocab_blob") + "/s.kgmap";
+	{
+		auto store = SessionStore::Create(path, SessionMeta{});
+		EXPECT_FALSE(store.hasStoredVocabulary());
+		EXPECT_FALSE(store.loadVocabulary().has_value());
+		store.storeVocabulary(voc, "in_run");
+	}
+	{
+		const auto store = SessionStore::Open(path);
+		EXPECT_TRUE(store.hasStoredVocabulary());
+		EXPECT_EQ(store.meta().vocabulary, vocabularyIdentity(voc, "in_run"));
+		const auto back = store.loadVocabulary();
+		ASSERT_TRUE(back.has_value());
+		std::ostringstream a, b;
+		voc.save(a);
+		back->save(b);
+		EXPECT_EQ(a.str(), b.str());
+	}
+	{
+		auto store = SessionStore::Open(path, SessionStore::Mode::ReadWrite);
+		store.setVocabulary({"other.bin", "0000000000000000", 9});
+	}
+	try
+	{
+		SessionStore::Open(path).loadVocabulary();
+		FAIL() << "no exception";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("is damaged: the stored vocabulary hashes to"), std::string::npos) << e.what();
+	}
 }

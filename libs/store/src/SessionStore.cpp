@@ -55,6 +55,7 @@ CREATE TABLE loop_constraints(
 CREATE TABLE snapshots(
   name TEXT PRIMARY KEY, last_keyframe INTEGER NOT NULL, written_utc TEXT NOT NULL,
   format TEXT NOT NULL, data BLOB NOT NULL) WITHOUT ROWID;
+CREATE TABLE vocabulary(id INTEGER PRIMARY KEY CHECK (id = 1), data BLOB NOT NULL);
 )SQL";
 
 std::string nowUtcIso()
@@ -365,24 +366,5 @@ void SessionStore::Check(const std::string& path)
 const std::string& SessionStore::path() const { return m_impl->db.path(); }
 const SessionMeta& SessionStore::meta() const { return m_impl->meta; }
 SessionStore::Mode SessionStore::mode() const { return m_impl->mode; }
-
-void SessionStore::setVocabulary(const VocabularyIdentity& vocabulary)
-{
-	if (m_impl->mode != Mode::ReadWrite)
-		throw std::logic_error("SessionStore::setVocabulary: '" + path() + "' was opened read-only");
-	const VocabularyIdentity before = m_impl->meta.vocabulary;
-	m_impl->meta.vocabulary = vocabulary;
-	try
-	{
-		detail::SqliteTransaction tx(m_impl->db);
-		m_impl->writeMeta();
-		tx.commit();
-	}
-	catch (...)
-	{
-		m_impl->meta.vocabulary = before;
-		throw;
-	}
-}
 
 }  // namespace keygrid::store

@@ -26,7 +26,8 @@ int info(const std::string& path)
 			  << "  keygrid_version    " << m.keygridVersion << "\n"
 			  << "  created_utc        " << m.createdUtc << "\n"
 			  << "  vocabulary         " << (m.vocabulary.empty() ? "(none)" : m.vocabulary.fileName) << " hash "
-			  << m.vocabulary.hash << " words " << m.vocabulary.words << "\n"
+			  << m.vocabulary.hash << " words " << m.vocabulary.words
+			  << (store.hasStoredVocabulary() ? " (stored in the file)" : "") << "\n"
 			  << "  camera             " << c.name << " " << c.width << "x" << c.height << " fx " << c.fx << " fy " << c.fy
 			  << " cx " << c.cx << " cy " << c.cy << " k1 " << c.dist[0] << " k2 " << c.dist[1] << " p1 " << c.dist[2]
 			  << " p2 " << c.dist[3] << " k3 " << c.dist[4] << " depth_units " << std::setprecision(7) << c.depthUnits << "\n"
@@ -75,6 +76,7 @@ int check(const std::string& path, bool images)
 									 " names a keyframe that is not stored");
 	const auto loops = store.loadLoopConstraints();
 	for (const auto& name : store.snapshotNames()) store.loadSnapshot(name);
+	store.loadVocabulary();
 	if (images)
 		for (const auto& kf : kfs) store.loadImages(kf.id);
 	std::cout << path << ": ok (schema version " << store.meta().schemaVersion << ", " << kfs.size() << " keyframes, "

@@ -9,6 +9,7 @@
  * A SessionStore is one connection: use it from one thread at a time (several SessionStore
  * objects, also in several processes, may read one file while one of them writes).
  */
+#include <keygrid/loop/Vocabulary.h>
 #include <keygrid/store/SessionRecords.h>
 #include <keygrid/store/SessionStoreOptions.h>
 
@@ -60,8 +61,16 @@ class SessionStore
 	 * on a read-only store, std::runtime_error naming the file on an SQLite error (the
 	 * transaction is rolled back). */
 	void write(const SessionUpdate& u);
-	/** Replaces the vocabulary identity (e.g. once a vocabulary was trained in-run). */
+	/** Replaces the vocabulary identity (a vocabulary file the session refers to by name and
+	 * hash). Throws std::logic_error on a read-only store. */
 	void setVocabulary(const VocabularyIdentity& vocabulary);
+	/** Stores the vocabulary itself in the file (e.g. one trained in-run, which exists nowhere
+	 * else) and sets the identity to it, in one transaction. */
+	void storeVocabulary(const loop::Vocabulary& vocabulary, const std::string& name);
+	/** The vocabulary stored by storeVocabulary(); nullopt when the file holds none. Throws
+	 * std::runtime_error naming the file when its bytes do not match the identity's hash. */
+	std::optional<loop::Vocabulary> loadVocabulary() const;
+	bool hasStoredVocabulary() const;
 
 	/** All keyframes by increasing id, without images. */
 	std::vector<KeyFrameRecord> loadKeyFrames() const;
