@@ -59,9 +59,8 @@ std::vector<T> readExact(BlobReader rd, std::size_t count, const std::string& wh
 	return rd.getArray<T>(count);
 }
 
-KeyFrameRecord readKeyFrame(const SqliteStatement& st, const SessionStore::Impl& im)
+KeyFrameRecord readKeyFrame(const SqliteStatement& st, const std::string& path, const std::map<std::int64_t, core::RgbdCamera>& cameras)
 {
-	const std::string& path = im.db.path();
 	KeyFrameRecord kf;
 	kf.id = static_cast<KeyFrameId>(st.int64(0));
 	kf.frameIndex = static_cast<std::uint64_t>(st.int64(1));
@@ -73,8 +72,8 @@ KeyFrameRecord readKeyFrame(const SqliteStatement& st, const SessionStore::Impl&
 	}
 	kf.hasParent = !st.isNull(4);
 	kf.parent = kf.hasParent ? static_cast<KeyFrameId>(st.int64(4)) : 0;
-	const auto cam = im.cameras.find(st.int64(5));
-	if (cam == im.cameras.end())
+	const auto cam = cameras.find(st.int64(5));
+	if (cam == cameras.end())
 		throw std::runtime_error(where(path, "keyframe", st.int64(0), "camera") + ": unknown camera " + std::to_string(st.int64(5)));
 	kf.camera = cam->second;
 	kf.numLevels = static_cast<int>(st.int64(6));
@@ -165,7 +164,7 @@ std::vector<KeyFrameRecord> SessionStore::loadKeyFrames() const
 	auto& im = *m_impl;
 	std::vector<KeyFrameRecord> out;
 	auto& st = im.statement(std::string(kKeyFrameColumns) + " ORDER BY id");
-	while (st.step()) out.push_back(readKeyFrame(st, im));
+	while (st.step()) out.push_back(readKeyFrame(st, im.db.path(), im.cameras));
 	st.reset();
 	return out;
 }
@@ -176,7 +175,7 @@ std::optional<KeyFrameRecord> SessionStore::loadKeyFrame(KeyFrameId id) const
 	auto& st = im.statement(std::string(kKeyFrameColumns) + " WHERE id = ?1");
 	st.bind(1, static_cast<std::int64_t>(id));
 	std::optional<KeyFrameRecord> out;
-	if (st.step()) out = readKeyFrame(st, im);
+	if (st.step()) out = readKeyFrame(st, im.db.path(), im.cameras);
 	st.reset();
 	return out;
 }

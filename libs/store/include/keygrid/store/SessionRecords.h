@@ -174,7 +174,9 @@ struct MapSnapshot
 };
 
 /** Everything one SessionStore::write() commits atomically: typically one new keyframe with
- * the landmarks and edges the mapping step created or changed. */
+ * the landmarks and edges the mapping step created or changed. Applied in the order of the
+ * fields: keyframes (+ images), poses, landmarks, erased landmarks, erased keyframes,
+ * covisibility, loops, snapshots. */
 struct SessionUpdate
 {
 	/** New keyframes (an existing id is replaced) and their images, same order; `images` may be

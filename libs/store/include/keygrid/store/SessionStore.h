@@ -92,9 +92,8 @@ class SessionStore
 	std::optional<MapSnapshot> loadSnapshot(const std::string& name) const;
 	SessionCounts counts() const;
 
-	struct Impl;
-
    private:
+	struct Impl;
 	explicit SessionStore(std::unique_ptr<Impl> impl);
 	std::unique_ptr<Impl> m_impl;
 };
