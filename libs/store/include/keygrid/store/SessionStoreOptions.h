@@ -21,9 +21,9 @@ struct SessionStoreOptions
 	 * A robot loses power more often than a desktop, and one fsync per keyframe (about 1 per
 	 * second) is cheap next to mapping, hence "full" (Default: full) */
 	std::string durability{"full"};
-	/** SQLite page cache per connection [KiB] (Default: 8192) */
+	/** SQLite page cache per connection [KiB], >= 64 (Default: 8192) */
 	int cacheSizeKiB{8192};
-	/** How long a statement waits for a lock held by another connection [ms] (Default: 5000) */
+	/** How long a statement waits for a lock held by another connection [ms], >= 0 (Default: 5000) */
 	int busyTimeoutMs{5000};
 	/** What Open() checks beyond application id and schema version: "quick" runs SQLite's
 	 * `PRAGMA quick_check`, which reads every page of the file (images included); "none" skips
