@@ -3,6 +3,7 @@
  * and the 3D visualization.
  */
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
+#include <keygrid/maps/ExportFrame.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/math/CQuaternion.h>
 #include <mrpt/opengl/CSetOfObjects.h>
@@ -63,7 +64,7 @@ void readOptions(CArchive& in, CISMOccupancyGrid2D::TInsertionOptions& o)
 }
 }  // namespace
 
-uint8_t CISMOccupancyGrid2D::serializeGetVersion() const { return 0; }
+uint8_t CISMOccupancyGrid2D::serializeGetVersion() const { return 1; }
 
 void CISMOccupancyGrid2D::serializeTo(CArchive& out) const
 {
@@ -85,6 +86,7 @@ void CISMOccupancyGrid2D::serializeTo(CArchive& out) const
 		}
 	}
 	out << m_nextAutoKeyframeId << m_lastRebuildSeconds;
+	out << m_floorExternal;  // version 1
 }
 
 void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
@@ -92,6 +94,7 @@ void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
 	switch (version)
 	{
 		case 0:
+		case 1:
 		{
 			readOptions(in, creationOptions);
 			readOptions(in, insertionOptions);
@@ -124,6 +127,8 @@ void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
 				m_keyframes[id] = std::move(kf);
 			}
 			in >> m_nextAutoKeyframeId >> m_lastRebuildSeconds;
+			m_floorExternal = false;
+			if (version >= 1) in >> m_floorExternal;
 			m_scratch.assign(m_logOdds.size(), 0.0f);
 			m_touched.clear();
 		}
@@ -166,12 +171,7 @@ void CISMOccupancyGrid2D::saveAsRosMapServer(const std::string& yamlPath) const
 	// The floor frame in the world (a comment: map_server and MRPT ignore it), so that a map
 	// whose floor was estimated can be compared with a ground truth in another frame. First
 	// line: libfyaml 0.8 (MRPT's YAML reader) leaks its input buffer on a trailing comment.
-	mrpt::math::CQuaternionDouble q;
-	const auto& F = floorPose();
-	F.getAsQuaternion(q);
-	std::snprintf(buf, sizeof(buf), "# keygrid T_world_floor (x y z qx qy qz qw): %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
-		F.x(), F.y(), F.z(), q.x(), q.y(), q.z(), q.r());
-	yaml << buf;
+	yaml << "# " << maps::floorFrameComment(floorPose()) << "\n";
 	std::snprintf(buf, sizeof(buf),
 		"image: %s\nresolution: %.9g\norigin: [%.9g, %.9g, 0.0]\nnegate: 0\n"
 		"occupied_thresh: 0.65\nfree_thresh: 0.196\n",

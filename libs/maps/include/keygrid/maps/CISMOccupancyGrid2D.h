@@ -197,8 +197,21 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 		const std::vector<mrpt::math::TPoint3D>& points_world,
 		const mrpt::poses::CPose3D& T_world_cam,
 		const std::optional<mrpt::math::TVector3D>& upHint = std::nullopt);
-	/** True once the floor frame is known (always when estimateFloorFromDepth is false). */
-	bool floorKnown() const { return !insertionOptions.estimateFloorFromDepth || m_floorEstimated; }
+	/** True once the floor frame is known (always when estimateFloorFromDepth is false and no
+	 * external floor is expected). */
+	bool floorKnown() const
+	{
+		return m_floorExternal ? m_floorEstimated : !insertionOptions.estimateFloorFromDepth || m_floorEstimated;
+	}
+	/** The floor frame comes from outside (keygrid-slam: the run's one floor frame,
+	 * maps::FloorFrameEstimator) and is not known yet: floorKnown() is false until
+	 * setExternalFloorPose(), and the grid never estimates a floor itself (its T_world_floor,
+	 * estimateFloorFromDepth, floorUpHint and floorRansac_* options are then unused). */
+	void expectExternalFloorPose();
+	/** Sets the floor frame from outside (see expectExternalFloorPose(), which this implies).
+	 * Keyframes integrated before keep the old floor until applyTrajectoryCorrection(). */
+	void setExternalFloorPose(const mrpt::poses::CPose3D& T_world_floor);
+	bool externalFloor() const { return m_floorExternal; }
 	/** @} */
 
 	/** @name Cell access (cell indices; (0,0) is the cell at (xMin, yMin))
@@ -225,11 +238,12 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	CellState stateAt(double x, double y) const { return cellState(x2idx(x), y2idx(y)); }
 	/** Number of cells in each state: {unknown, free, occupied}. */
 	std::array<size_t, 3> countStates() const;
-	/** The floor frame in use: the estimate when estimateFloorFromDepth, else T_world_floor. */
+	/** The floor frame in use: the external one when set, the estimate when
+	 * estimateFloorFromDepth, else T_world_floor. */
 	const mrpt::poses::CPose3D& floorPose() const
 	{
-		return insertionOptions.estimateFloorFromDepth ? m_T_world_floorEstimate
-													   : insertionOptions.T_world_floor;
+		return m_floorExternal || insertionOptions.estimateFloorFromDepth ? m_T_world_floorEstimate
+																		  : insertionOptions.T_world_floor;
 	}
 	/** @} */
 
@@ -268,6 +282,8 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	std::vector<float> m_logOdds;  ///< row-major, index cx + cy * m_sizeX
 	mrpt::poses::CPose3D m_T_world_floorEstimate;  ///< RANSAC estimate, if m_floorEstimated
 	bool m_floorEstimated{false};
+	/** The floor is set from outside (setExternalFloorPose) into m_T_world_floorEstimate. */
+	bool m_floorExternal{false};
 	std::map<uint64_t, KeyframeRays> m_keyframes;
 	uint64_t m_nextAutoKeyframeId{1ULL << 62};  ///< ids for insertObservation() inputs
 	double m_lastRebuildSeconds{0};

@@ -1,0 +1,178 @@
+/** \file floor_estimate_eval.cpp
+ * keygrid_floor_estimate_eval: error of keygrid-slam's floor frame against a z-up ground
+ * truth whose floor is z = 0 (keygrid-sim's world).
+ *
+ *   keygrid_floor_estimate_eval --gt GT.txt --traj trajectory.txt --report report.json [--name N]
+ *
+ * The SLAM world is carried into the ground-truth world by the SE(3) Umeyama alignment of the
+ * trajectory's camera centres to the ground truth at common timestamps (T_gt_world). Each
+ * floor estimate T_world_floor of report.json ("floor": its "history" of accepted estimates,
+ * or the final "T_world_floor" when given) becomes T_gt_floor = T_gt_world * T_world_floor;
+ * its error is the tilt (angle between its z axis and +z) and the height offset (z of the
+ * estimated floor plane under the centroid of the ground-truth camera positions).
+ *
+ * Output: one line, "key value" pairs: scene, number of accepted estimates, the estimate in
+ * force at 10 keyframes (the keyframe count it was made at), its offset and tilt, the worst
+ * |offset| and tilt of it and all later estimates, and the final estimate's (the report's
+ * T_world_floor, after the last trajectory correction).
+ */
+#include <keygrid/core/TumTrajectory.h>
+#include <keygrid/eval/Alignment.h>
+#include <mrpt/math/CMatrixFixed.h>
+#include <mrpt/poses/CPose3DQuat.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+using namespace keygrid;
+
+namespace
+{
+const mrpt::poses::CPose3D* poseAt(const core::Trajectory& t, double stamp)
+{
+	auto it = std::lower_bound(t.begin(), t.end(), stamp, [](const core::StampedPose& p, double s) { return p.t < s; });
+	for (auto c : {it, it == t.begin() ? it : it - 1})
+		if (c != t.end() && std::abs(c->t - stamp) < 1e-4) return &c->T_world_cam;
+	return nullptr;
+}
+
+mrpt::poses::CPose3D umeyama(const core::Trajectory& gt, const core::Trajectory& est, Eigen::Vector3d& gtCentroid)
+{
+	std::vector<Eigen::Vector3d> x, y;
+	for (const auto& e : est)
+		if (const auto* g = poseAt(gt, e.t))
+		{
+			x.emplace_back(e.T_world_cam.x(), e.T_world_cam.y(), e.T_world_cam.z());
+			y.emplace_back(g->x(), g->y(), g->z());
+		}
+	if (x.size() < 3) throw std::runtime_error("fewer than 3 common timestamps between the trajectories");
+	gtCentroid.setZero();
+	for (const auto& p : y) gtCentroid += p;
+	gtCentroid /= static_cast<double>(y.size());
+	const auto s = eval::alignPointSets(x, y, false);
+	mrpt::math::CMatrixDouble44 H;
+	H.setIdentity();
+	for (int r = 0; r < 3; r++)
+	{
+		for (int c = 0; c < 3; c++) H(r, c) = s.R(r, c);
+		H(r, 3) = s.t(r);
+	}
+	return mrpt::poses::CPose3D(H);
+}
+
+struct Estimate
+{
+	long keyframes{-1};  //!< -1: the final one
+	mrpt::poses::CPose3D T_world_floor;
+};
+
+mrpt::poses::CPose3D poseFromJson(const std::string& arr)
+{
+	std::istringstream is(std::regex_replace(arr, std::regex("[\\[\\],]"), " "));
+	double x, y, z, qx, qy, qz, qw;
+	if (!(is >> x >> y >> z >> qx >> qy >> qz >> qw)) throw std::runtime_error("bad pose " + arr);
+	return mrpt::poses::CPose3D(mrpt::poses::CPose3DQuat(x, y, z, mrpt::math::CQuaternionDouble(qw, qx, qy, qz)));
+}
+
+/** The history and the final estimate of report.json's "floor" object. */
+std::vector<Estimate> readEstimates(const std::string& path)
+{
+	std::ifstream f(path);
+	if (!f) throw std::runtime_error("cannot read " + path);
+	std::stringstream ss;
+	ss << f.rdbuf();
+	const std::string js = ss.str();
+	const auto at = js.find("\"floor\": {");
+	if (at == std::string::npos) throw std::runtime_error(path + " has no floor frame");
+	const std::string fl = js.substr(at, js.find('\n', at) - at);
+	std::vector<Estimate> out;
+	const std::regex entry("\\{\"keyframes\": (\\d+)[^{]*?\"T_world_floor\": (\\[[^\\]]*\\])");
+	for (auto it = std::sregex_iterator(fl.begin(), fl.end(), entry); it != std::sregex_iterator(); ++it)
+		out.push_back({std::stol((*it)[1]), poseFromJson((*it)[2])});
+	std::smatch m;
+	if (!std::regex_search(fl, m, std::regex("\"T_world_floor\": (\\[[^\\]]*\\])")))
+		throw std::runtime_error(path + ": the run has no floor frame");
+	out.push_back({-1, poseFromJson(m[1])});
+	return out;
+}
+
+struct Error
+{
+	double offset{0}, tiltDeg{0};
+};
+
+Error floorError(const mrpt::poses::CPose3D& T_gt_floor, const Eigen::Vector3d& c)
+{
+	const auto R = T_gt_floor.getRotationMatrix();
+	const Eigen::Vector3d n(R(0, 2), R(1, 2), R(2, 2));
+	const Eigen::Vector3d o(T_gt_floor.x(), T_gt_floor.y(), T_gt_floor.z());
+	Error e;
+	e.tiltDeg = std::acos(std::clamp(n.z(), -1.0, 1.0)) * 180.0 / M_PI;
+	// Plane n.(p - o) = 0 at (c.x, c.y): z = o.z - (n.x (c.x - o.x) + n.y (c.y - o.y)) / n.z
+	e.offset = o.z() - (n.x() * (c.x() - o.x()) + n.y() * (c.y() - o.y())) / n.z();
+	return e;
+}
+}  // namespace
+
+int main(int argc, char** argv)
+{
+	try
+	{
+		std::string gtPath, trajPath, reportPath, name = "-";
+		for (int i = 1; i < argc; i++)
+		{
+			const std::string k = argv[i];
+			if (i + 1 >= argc) throw std::invalid_argument("missing value after " + k);
+			const std::string v = argv[++i];
+			if (k == "--gt") gtPath = v;
+			else if (k == "--traj") trajPath = v;
+			else if (k == "--report") reportPath = v;
+			else if (k == "--name") name = v;
+			else throw std::invalid_argument("unknown option " + k);
+		}
+		if (gtPath.empty() || trajPath.empty() || reportPath.empty())
+			throw std::invalid_argument("usage: keygrid_floor_estimate_eval --gt GT.txt --traj trajectory.txt --report report.json [--name N]");
+		const auto gt = core::readTumTrajectory(gtPath);
+		const auto est = core::readTumTrajectory(trajPath);
+		Eigen::Vector3d centroid;
+		const mrpt::poses::CPose3D T_gt_world = umeyama(gt, est, centroid);
+		const auto estimates = readEstimates(reportPath);
+		// The estimate in force at 10 keyframes: the last one from at most 10 (an unchanged
+		// estimate is not repeated), else the first one after.
+		const Estimate* at10 = nullptr;
+		Error last;
+		for (const auto& e : estimates)
+			if (e.keyframes < 0)
+				last = floorError(T_gt_world + e.T_world_floor, centroid);
+			else if (e.keyframes <= 10 || !at10)
+				at10 = &e;
+		if (!at10) throw std::runtime_error(reportPath + ": no floor estimate in the history");
+		const Error e10 = floorError(T_gt_world + at10->T_world_floor, centroid);
+		Error worst{std::abs(e10.offset), e10.tiltDeg};
+		for (const auto& e : estimates)
+			if (e.keyframes > at10->keyframes)
+			{
+				const Error err = floorError(T_gt_world + e.T_world_floor, centroid);
+				worst.offset = std::max(worst.offset, std::abs(err.offset));
+				worst.tiltDeg = std::max(worst.tiltDeg, err.tiltDeg);
+			}
+		std::printf("scene %s estimates %zu in_force_at_10_kf_from_kf %ld offset_10kf_cm %.2f tilt_10kf_deg %.2f worst_from_10kf_offset_cm %.2f "
+					"worst_from_10kf_tilt_deg %.2f final_offset_cm %.2f final_tilt_deg %.2f\n",
+					name.c_str(), estimates.size() - 1, at10->keyframes, 100 * e10.offset, e10.tiltDeg, 100 * worst.offset,
+					worst.tiltDeg, 100 * last.offset, last.tiltDeg);
+		return 0;
+	}
+	catch (const std::exception& ex)
+	{
+		std::fprintf(stderr, "keygrid_floor_estimate_eval: %s\n", ex.what());
+		return 1;
+	}
+}
