@@ -517,10 +517,12 @@ bool FloorFrameEstimator::due() const
 	return (k - m_opts.initialKeyframes) % m_opts.reestimateEvery == 0;
 }
 
-bool FloorFrameEstimator::addKeyframe(uint64_t id, const mrpt::poses::CPose3D& T_world_cam, const std::vector<TPoint3Df>& samples)
+bool FloorFrameEstimator::addKeyframe(
+	uint64_t id, const mrpt::poses::CPose3D& T_world_cam, const std::vector<TPoint3Df>& samples, double stamp)
 {
 	if (m_given) return false;
 	const bool known = m_poses.count(id) > 0;
+	m_lastStamp = std::max(m_lastStamp, stamp);
 	if (m_poses.empty()) m_firstKeyframe = id;
 	m_poses[id] = T_world_cam;
 	if (known) return false;
@@ -596,6 +598,7 @@ bool FloorFrameEstimator::reestimate()
 	m_T_world_floor = floorPoseFromPlane(fit->plane, cam, first.rotateVector(TVector3D(0, 0, 1)));
 	Update u;
 	u.keyframes = m_poses.size();
+	u.stamp = m_lastStamp;
 	u.T_world_floor = *m_T_world_floor;
 	u.samples = pts.size();
 	u.inliers = fit->plane.inliers;
@@ -624,15 +627,15 @@ std::string FloorFrameEstimator::toJson() const
 	std::ostringstream o;
 	o << "{\"source\": \"" << (m_given ? "given" : m_T_world_floor ? "estimated" : "none") << "\"";
 	o << ", \"T_world_floor\": " << (m_T_world_floor ? poseJson(*m_T_world_floor) : std::string("null"));
-	char b[160];
+	char b[320];
 	std::snprintf(b, sizeof(b), ", \"keyframes\": %zu, \"samples\": %zu, \"estimates\": %zu, \"seconds\": %.4f", m_poses.size(),
 				  m_samples.size(), m_estimates, m_seconds);
 	o << b << ", \"history\": [";
 	for (std::size_t i = 0; i < m_history.size(); i++)
 	{
 		const auto& u = m_history[i];
-		std::snprintf(b, sizeof(b), "%s{\"keyframes\": %zu, \"samples\": %zu, \"inliers\": %zu, \"below\": %zu, \"clear_below\": %s, \"planes\": %zu, \"walls\": %zu, \"T_world_floor\": ",
-					  i ? ", " : "", u.keyframes, u.samples, u.inliers, u.below, u.clearBelow ? "true" : "false", u.planes, u.walls);
+		std::snprintf(b, sizeof(b), "%s{\"keyframes\": %zu, \"stamp\": %.6f, \"samples\": %zu, \"inliers\": %zu, \"below\": %zu, \"clear_below\": %s, \"planes\": %zu, \"walls\": %zu, \"T_world_floor\": ",
+					  i ? ", " : "", u.keyframes, u.stamp, u.samples, u.inliers, u.below, u.clearBelow ? "true" : "false", u.planes, u.walls);
 		o << b << poseJson(u.T_world_floor) << "}";
 	}
 	o << "]}";

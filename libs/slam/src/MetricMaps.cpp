@@ -171,7 +171,7 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 					const auto q = kf.T_world_cam.inverseComposePoint(mrpt::math::TPoint3D(p.x(), p.y(), p.z()));
 					samples.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
 				}
-		if (m_floor.addKeyframe(id, kf.T_world_cam, samples)) floorChanged();
+		if (m_floor.addKeyframe(id, kf.T_world_cam, samples, kf.timestamp)) floorChanged();
 	}
 	mrpt::obs::CObservation3DRangeScan::Ptr obs;  // built on demand
 	for (std::size_t i = 0; i < m_maps.maps.size(); i++)

@@ -4,18 +4,20 @@
  *
  *   keygrid_floor_estimate_eval --gt GT.txt --traj trajectory.txt --report report.json [--name N]
  *
- * The SLAM world is carried into the ground-truth world by the SE(3) Umeyama alignment of the
- * trajectory's camera centres to the ground truth at common timestamps (T_gt_world). Each
- * floor estimate T_world_floor of report.json ("floor": its "history" of accepted estimates,
- * or the final "T_world_floor" when given) becomes T_gt_floor = T_gt_world * T_world_floor;
- * its error is the tilt (angle between its z axis and +z) and the height offset (z of the
- * estimated floor plane under the centroid of the ground-truth camera positions).
- *
- * Output: one line, "key value" pairs: scene, number of accepted estimates, the estimate in
- * force at 10 keyframes (the keyframe count it was made at), its offset and tilt, the worst
- * |offset| and tilt of it and all later estimates, and the final estimate's (the report's
- * T_world_floor, after the last trajectory correction).
- */
+ * Each floor estimate T_world_floor of report.json ("floor": its "history" of accepted
+ * estimates with the keyframe count and timestamp they were made at, and the final
+ * "T_world_floor") is carried into the ground-truth world, T_gt_floor = T_gt_world *
+ * T_world_floor, and scored by its tilt (angle between its z axis and +z) and height offset
+ * (z of the estimated floor plane under the centroid of the ground-truth camera positions
+ * up to the estimate's time). T_gt_world:
+ *  - for the final estimate, the SE(3) Umeyama alignment of trajectory.txt (the final poses)
+ *    to the ground truth at common timestamps;
+ *  - for the estimates made during the run, the world they were made in: the SLAM world is
+ *    the first camera's frame, held fixed by the bundle adjustments and pose graphs, so
+ *    T_gt_world = T_gt_cam(t0) * inverse(T_world_cam(t0)) with the first frame's online pose
+ *    (trajectory_online.txt, next to trajectory.txt). A Umeyama alignment of the poses up to
+ *    the estimate would leave the rotation about a short, nearly straight path unresolved.
+ * */
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/eval/Alignment.h>
 #include <mrpt/math/CMatrixFixed.h>
@@ -71,6 +73,7 @@ mrpt::poses::CPose3D umeyama(const core::Trajectory& gt, const core::Trajectory&
 struct Estimate
 {
 	long keyframes{-1};  //!< -1: the final one
+	double stamp{0};
 	mrpt::poses::CPose3D T_world_floor;
 };
 
@@ -94,13 +97,13 @@ std::vector<Estimate> readEstimates(const std::string& path)
 	if (at == std::string::npos) throw std::runtime_error(path + " has no floor frame");
 	const std::string fl = js.substr(at, js.find('\n', at) - at);
 	std::vector<Estimate> out;
-	const std::regex entry("\\{\"keyframes\": (\\d+)[^{]*?\"T_world_floor\": (\\[[^\\]]*\\])");
+	const std::regex entry("\\{\"keyframes\": (\\d+), \"stamp\": ([0-9.eE+-]+)[^{]*?\"T_world_floor\": (\\[[^\\]]*\\])");
 	for (auto it = std::sregex_iterator(fl.begin(), fl.end(), entry); it != std::sregex_iterator(); ++it)
-		out.push_back({std::stol((*it)[1]), poseFromJson((*it)[2])});
+		out.push_back({std::stol((*it)[1]), std::stod((*it)[2]), poseFromJson((*it)[3])});
 	std::smatch m;
 	if (!std::regex_search(fl, m, std::regex("\"T_world_floor\": (\\[[^\\]]*\\])")))
 		throw std::runtime_error(path + ": the run has no floor frame");
-	out.push_back({-1, poseFromJson(m[1])});
+	out.push_back({-1, 0.0, poseFromJson(m[1])});
 	return out;
 }
 
@@ -142,8 +145,25 @@ int main(int argc, char** argv)
 			throw std::invalid_argument("usage: keygrid_floor_estimate_eval --gt GT.txt --traj trajectory.txt --report report.json [--name N]");
 		const auto gt = core::readTumTrajectory(gtPath);
 		const auto est = core::readTumTrajectory(trajPath);
-		Eigen::Vector3d centroid;
-		const mrpt::poses::CPose3D T_gt_world = umeyama(gt, est, centroid);
+		const std::string onlinePath = trajPath.substr(0, trajPath.find_last_of('/') + 1) + "trajectory_online.txt";
+		const auto online = core::readTumTrajectory(onlinePath);
+		Eigen::Vector3d centroidAll;
+		const mrpt::poses::CPose3D T_gt_worldFinal = umeyama(gt, est, centroidAll);
+		const auto* gt0 = online.empty() ? nullptr : poseAt(gt, online.front().t);
+		if (!gt0) throw std::runtime_error(onlinePath + ": its first frame has no ground truth");
+		const mrpt::poses::CPose3D T_gt_worldRun = *gt0 + (-online.front().T_world_cam);
+		// Centroid of the ground-truth camera positions up to `stamp`.
+		auto centroidUpTo = [&](double stamp) {
+			Eigen::Vector3d c = Eigen::Vector3d::Zero();
+			std::size_t n = 0;
+			for (const auto& p : gt)
+				if (p.t <= stamp + 1e-6)
+				{
+					c += Eigen::Vector3d(p.T_world_cam.x(), p.T_world_cam.y(), p.T_world_cam.z());
+					n++;
+				}
+			return n ? Eigen::Vector3d(c / static_cast<double>(n)) : centroidAll;
+		};
 		const auto estimates = readEstimates(reportPath);
 		// The estimate in force at 10 keyframes: the last one from at most 10 (an unchanged
 		// estimate is not repeated), else the first one after.
@@ -151,16 +171,17 @@ int main(int argc, char** argv)
 		Error last;
 		for (const auto& e : estimates)
 			if (e.keyframes < 0)
-				last = floorError(T_gt_world + e.T_world_floor, centroid);
+				last = floorError(T_gt_worldFinal + e.T_world_floor, centroidAll);
 			else if (e.keyframes <= 10 || !at10)
 				at10 = &e;
 		if (!at10) throw std::runtime_error(reportPath + ": no floor estimate in the history");
-		const Error e10 = floorError(T_gt_world + at10->T_world_floor, centroid);
+		auto runError = [&](const Estimate& e) { return floorError(T_gt_worldRun + e.T_world_floor, centroidUpTo(e.stamp)); };
+		const Error e10 = runError(*at10);
 		Error worst{std::abs(e10.offset), e10.tiltDeg};
 		for (const auto& e : estimates)
 			if (e.keyframes > at10->keyframes)
 			{
-				const Error err = floorError(T_gt_world + e.T_world_floor, centroid);
+				const Error err = runError(e);
 				worst.offset = std::max(worst.offset, std::abs(err.offset));
 				worst.tiltDeg = std::max(worst.tiltDeg, err.tiltDeg);
 			}

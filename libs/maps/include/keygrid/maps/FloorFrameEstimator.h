@@ -142,6 +142,7 @@ class FloorFrameEstimator
 	struct Update
 	{
 		std::size_t keyframes{0};  //!< keyframes that had contributed samples
+		double stamp{0};  //!< timestamp of the newest of them [s]
 		mrpt::poses::CPose3D T_world_floor;
 		std::size_t samples{0}, inliers{0}, below{0};
 		bool clearBelow{true};
@@ -151,12 +152,12 @@ class FloorFrameEstimator
 	explicit FloorFrameEstimator(const FloorFrameOptions& opts = {});
 
 	const FloorFrameOptions& options() const { return m_opts; }
-	/** Adds a keyframe's samples (its camera frame) at its pose; re-estimates when the
-	 * schedule says so. Returns true when the floor frame changed. A keyframe added again
-	 * only updates its pose. */
+	/** Adds a keyframe's samples (its camera frame) at its pose, taken at `stamp` [s];
+	 * re-estimates when the schedule says so. Returns true when the floor frame changed. A
+	 * keyframe added again only updates its pose. */
 	bool addKeyframe(
 		uint64_t id, const mrpt::poses::CPose3D& T_world_cam,
-		const std::vector<mrpt::math::TPoint3Df>& samples_cam);
+		const std::vector<mrpt::math::TPoint3Df>& samples_cam, double stamp = 0);
 	/** New poses of known keyframes (others are ignored), then a re-estimate. Returns true
 	 * when the floor frame changed. */
 	bool updatePoses(const std::map<uint64_t, mrpt::poses::CPose3D>& newPoses);
@@ -196,6 +197,7 @@ class FloorFrameEstimator
 	std::optional<FloorPlane> m_plane;  //!< plane of the last accepted estimate
 	std::map<uint64_t, mrpt::poses::CPose3D> m_poses;  //!< keyframes with samples, current poses
 	uint64_t m_firstKeyframe{0};
+	double m_lastStamp{0};  //!< timestamp of the newest keyframe
 	std::vector<Sample> m_samples;
 	std::size_t m_seen{0};  //!< samples offered to the reservoir
 	std::mt19937 m_rng;
