@@ -413,6 +413,33 @@ TEST(Outputs, MapOutputsShareTheEstimatedFloorFrame)
 	}
 }
 
+TEST(Outputs, FloorFrameExistsWithOnlyThe3DGrid)
+{
+	// The floor estimate belongs to the run, not to the 2D grid: with the 3D grid alone, its
+	// files are in the floor frame all the same.
+	const std::string dir = test::scratchDir("outputs_floor_3d_only");
+	auto run = test::renderAndRunSlam(
+		dir, "--scene " + test::dataDir() + "/sim/room_arc.ini --frames 40 --voxel-resolution 0 --floorplan-resolution 0", false);
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	auto o = run.options;
+	o.output = dir + "/out3d";
+	o.set = "MappingApplication.ismOccupancyGrid2D_count = 0; MappingApplication.hocPointsMap_count = 0";
+	const auto r = slam::runSlam(o);
+	ASSERT_TRUE(r.error.empty()) << r.error;
+	EXPECT_FALSE(mrpt::system::fileExists(o.output + "/map_2d.yaml"));
+	const auto T_world_floor = reportFloorPose(test::readTextFile(o.output + "/report.json"));
+	ASSERT_TRUE(T_world_floor);
+	const auto gt = core::readTumTrajectory(dir + "/seq/groundtruth.txt");
+	const mrpt::poses::CPose3D T_sim_floor = gt.front().T_world_cam + *T_world_floor;
+	EXPECT_NEAR(T_sim_floor.z(), 0.0, 0.02);
+	EXPECT_GT(T_sim_floor.getRotationMatrix()(2, 2), std::cos(1.0 * M_PI / 180.0));
+	EXPECT_NE(test::readTextFile(o.output + "/map_3d.ply").find("comment " + maps::floorFrameComment(*T_world_floor)), std::string::npos);
+	std::vector<double> z;
+	for (const auto& p : plyPoints(o.output + "/map_3d.ply")) z.push_back(p.z);
+	ASSERT_GT(z.size(), 1000u);
+	EXPECT_NEAR(quantile(z, 0.005), 0.0, 0.05);
+}
+
 TEST(Outputs, RawlogEditLoadsTheMapsPlugin)
 {
 	KEYGRID_SKIP_IF_SANITIZED();
