@@ -3,6 +3,7 @@
  * truth whose floor is z = 0 (keygrid-sim's world).
  *
  *   keygrid_floor_estimate_eval --gt GT.txt --traj trajectory.txt --report report.json [--name N]
+ *       [--history]   (also one line per estimate)
  *
  * Each floor estimate T_world_floor of report.json ("floor": its "history" of accepted
  * estimates with the keyframe count and timestamp they were made at, and the final
@@ -12,11 +13,13 @@
  * up to the estimate's time). T_gt_world:
  *  - for the final estimate, the SE(3) Umeyama alignment of trajectory.txt (the final poses)
  *    to the ground truth at common timestamps;
- *  - for the estimates made during the run, the world they were made in: the SLAM world is
- *    the first camera's frame, held fixed by the bundle adjustments and pose graphs, so
- *    T_gt_world = T_gt_cam(t0) * inverse(T_world_cam(t0)) with the first frame's online pose
- *    (trajectory_online.txt, next to trajectory.txt). A Umeyama alignment of the poses up to
- *    the estimate would leave the rotation about a short, nearly straight path unresolved.
+ *  - for the estimates made during the run before its first loop closure, the world they
+ *    were made in: the SLAM world is the first camera's frame, so T_gt_world = T_gt_cam(t0) *
+ *    inverse(T_world_cam(t0)) with the first frame's online pose (trajectory_online.txt, next
+ *    to trajectory.txt). A Umeyama alignment of the poses up to the estimate would leave the
+ *    rotation about a short, nearly straight path unresolved;
+ *  - for those made from the first loop closure on (report.json "loop_closures", its
+ *    keyframe_timestamp), under corrected poses: the final alignment, as for the final one.
  * */
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/eval/Alignment.h>
@@ -130,9 +133,15 @@ int main(int argc, char** argv)
 	try
 	{
 		std::string gtPath, trajPath, reportPath, name = "-";
+		bool history = false;
 		for (int i = 1; i < argc; i++)
 		{
 			const std::string k = argv[i];
+			if (k == "--history")
+			{
+				history = true;
+				continue;
+			}
 			if (i + 1 >= argc) throw std::invalid_argument("missing value after " + k);
 			const std::string v = argv[++i];
 			if (k == "--gt") gtPath = v;
@@ -165,6 +174,16 @@ int main(int argc, char** argv)
 			return n ? Eigen::Vector3d(c / static_cast<double>(n)) : centroidAll;
 		};
 		const auto estimates = readEstimates(reportPath);
+		double firstLoop = 1e300;
+		{
+			std::ifstream f(reportPath);
+			std::stringstream ss;
+			ss << f.rdbuf();
+			std::smatch m;
+			const std::string js = ss.str();
+			if (std::regex_search(js, m, std::regex("\"loop_closures\": \\[\\{[^}]*\"keyframe_timestamp\": ([0-9.eE+-]+)")))
+				firstLoop = std::stod(m[1]);
+		}
 		// The estimate in force at 10 keyframes: the last one from at most 10 (an unchanged
 		// estimate is not repeated), else the first one after.
 		const Estimate* at10 = nullptr;
@@ -175,7 +194,16 @@ int main(int argc, char** argv)
 			else if (e.keyframes <= 10 || !at10)
 				at10 = &e;
 		if (!at10) throw std::runtime_error(reportPath + ": no floor estimate in the history");
-		auto runError = [&](const Estimate& e) { return floorError(T_gt_worldRun + e.T_world_floor, centroidUpTo(e.stamp)); };
+		auto runError = [&](const Estimate& e) {
+			return floorError((e.stamp + 1e-6 >= firstLoop ? T_gt_worldFinal : T_gt_worldRun) + e.T_world_floor, centroidUpTo(e.stamp));
+		};
+		if (history)
+			for (const auto& e : estimates)
+				if (e.keyframes >= 0)
+				{
+					const Error err = runError(e);
+					std::printf("estimate keyframes %ld stamp %.3f offset_cm %.2f tilt_deg %.2f\n", e.keyframes, e.stamp, 100 * err.offset, err.tiltDeg);
+				}
 		const Error e10 = runError(*at10);
 		Error worst{std::abs(e10.offset), e10.tiltDeg};
 		for (const auto& e : estimates)
