@@ -22,7 +22,8 @@ using mrpt::math::TVector3D;
 // ------------------------------------------------------------------ options
 void FloorFrameOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	givenPose = c.read_string(s, "T_world_floor", givenPose);
+	givenPose = c.read_string(s, "T_world_floor", givenPose.empty() ? "estimate" : givenPose);
+	if (givenPose == "estimate") givenPose.clear();
 	const std::string up = c.read_string(s, "up_hint", "");
 	if (!up.empty())
 	{
@@ -61,7 +62,8 @@ void FloorFrameOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const
 {
 	char up[96];
 	std::snprintf(up, sizeof(up), "%g %g %g", upHint.x, upHint.y, upHint.z);
-	c.write(s, "T_world_floor", givenPose, 30, 40, "given floor frame [x y z yaw pitch roll] (m, deg) in the SLAM world; empty = estimate");
+	c.write(s, "T_world_floor", givenPose.empty() ? std::string("estimate") : givenPose, 30, 40,
+			"estimate, or the floor frame given as [x y z yaw pitch roll] (m, deg) in the SLAM world");
 	c.write(s, "up_hint", std::string(up), 30, 40, "\"up\" in the SLAM world for the first search; 0 0 0 = mean -y of the keyframe cameras");
 	c.write(s, "initial_keyframes", initialKeyframes, 30, 40, "estimate at every keyframe until this many contributed (and the floor is found)");
 	c.write(s, "reestimate_every", reestimateEvery, 30, 40, "then re-estimate every N keyframes and after trajectory corrections");

@@ -29,7 +29,7 @@ namespace keygrid::maps
 struct FloorFrameOptions
 {
 	/** The floor frame given instead of estimated, "[x y z yaw pitch roll]" (m, deg) in the
-	 * SLAM world; empty = estimate it (Default: empty) */
+	 * SLAM world; empty (INI: "estimate") = estimate it (Default: empty) */
 	std::string givenPose;
 	/** "Up" in the SLAM world for the first search, "x y z"; (0 0 0) = the mean -y axis of
 	 * the keyframe cameras so far (Default: 0 0 0) */
@@ -92,7 +92,8 @@ struct FloorFrameOptions
 	/** Random seed of the reservoir and of RANSAC (Default: 1) */
 	uint32_t seed{1};
 
-	/** Keys (`T_world_floor`, `up_hint`, `initial_keyframes`, ...) in `section`. */
+	/** Keys (`T_world_floor` = estimate | [x y z yaw pitch roll], `up_hint`,
+	 * `initial_keyframes`, ...) in `section`. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& section) const;
 	/** Throws std::invalid_argument naming the key of a bad value (and `section`). */
