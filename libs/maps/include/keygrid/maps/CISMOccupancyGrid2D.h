@@ -35,7 +35,8 @@ enum class CellState : uint8_t
  * Frames: the grid lives in the floor frame F (z up, z = 0 on the floor); its pose in the
  * world is insertionOptions.T_world_floor, or a RANSAC estimate of the floor plane from the
  * first depth image when insertionOptions.estimateFloorFromDepth is set (TUM's world frame is
- * not gravity aligned). A 3D point p_F is an obstacle when obstacleMinHeight <= z <=
+ * not gravity aligned), or set from outside (setExternalFloorPose: keygrid-slam hands every
+ * grid the run's one floor frame). A 3D point p_F is an obstacle when obstacleMinHeight <= z <=
  * obstacleMaxHeight, floor when |z| <= floorTolerance (it then only clears space), and ignored
  * otherwise. Every kept point casts a 2D ray from the camera's footprint to the point's
  * footprint; the cells on it are updated with l += logit(ISM(r)) - l0.
