@@ -20,6 +20,7 @@
 #include <opencv2/core.hpp>
 
 #include <fstream>
+#include <sstream>
 
 using namespace keygrid;
 using mrpt::poses::CPose3D;
@@ -232,6 +233,74 @@ TEST(SubmappedIo, OctomapExportAgreesVoxelByVoxel)
 	const auto* cm = dynamic_cast<const CSubmappedOccupancyGrid3D*>(c.get());
 	ASSERT_TRUE(cm);
 	EXPECT_TRUE(cm->submap(0).grid == g);
+}
+
+TEST(SubmappedIo, ExportsInAnotherFrameResampledAndRecorded)
+{
+	// keygrid-slam writes map_3d.bt / .ply in the floor frame: a rigid change of frame with a
+	// metadata line. The .bt is resampled at the same resolution (nearest neighbour).
+	CSubmappedOccupancyGrid3D m(0.05);
+	const auto cam = test::smallCamera(80, 60, 70);
+	const CPose3D T(0.1, -0.05, 0.2, 0.3, 0.1, -0.05);
+	m.insertDepthFrame(test::boxRoomDepth(cam, T, {-2, -1.5, -1}, {2.5, 1.5, 3}), cam, T, 0.0, 0);
+	const CPose3D T_world_floor(0.2, 1.1, -0.3, 0.4, -0.2, 1.2);
+	const auto frame = maps::floorExportFrame(T_world_floor);
+	const std::string dir = test::scratchDir("grid3d_export_frame");
+	m.saveAsOctomapBinary(dir + "/floor.bt", frame);
+	m.saveOccupiedAsPly(dir + "/floor.ply", frame);
+
+	// OctoMap's reader takes the comment line (AbstractOcTree::readHeader skips '#' lines).
+	{
+		std::ifstream f(dir + "/floor.bt");
+		std::string first, second;
+		std::getline(f, first);
+		std::getline(f, second);
+		EXPECT_EQ(first.rfind("# Octomap OcTree binary file", 0), 0u) << first;
+		EXPECT_EQ(second, "# " + frame.comment);
+	}
+	octomap::OcTree tree(0.1);
+	ASSERT_TRUE(tree.readBinary(dir + "/floor.bt"));
+	ASSERT_DOUBLE_EQ(tree.getResolution(), 0.05);
+	// Every leaf of the output lattice has the state of the world voxel holding its centre,
+	// and the lattice holds as many voxels as the world grid, within the resampling's few %.
+	const auto& g = m.submap(0).grid;
+	std::size_t leaves = 0, bad = 0, known = 0;
+	g.forEachKnown([&](const VoxelIndex&, const Voxel&) { ++known; });
+	tree.expand();
+	for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it)
+	{
+		++leaves;
+		const auto c = it.getCoordinate();
+		const auto w = T_world_floor.composePoint(mrpt::math::TPoint3D(c.x(), c.y(), c.z()));
+		const Voxel* v = g.find(g.voxelOf(w));
+		if (!v || !v->isKnown() || (v->logOdds > 0) != tree.isNodeOccupied(*it)) ++bad;
+	}
+	EXPECT_EQ(bad, 0u);
+	EXPECT_NEAR(static_cast<double>(leaves) / known, 1.0, 0.05);
+
+	// The PLY: the occupied centres moved exactly, with the same comment.
+	std::ifstream ply(dir + "/floor.ply");
+	std::string line;
+	bool body = false, commented = false;
+	std::vector<mrpt::math::TPoint3D> pts;
+	while (std::getline(ply, line))
+	{
+		if (body)
+		{
+			std::istringstream is(line);
+			double x, y, z;
+			is >> x >> y >> z;
+			pts.emplace_back(x, y, z);
+		}
+		else if (line == "comment " + frame.comment) commented = true;
+		else if (line == "end_header") body = true;
+	}
+	EXPECT_TRUE(commented);
+	const auto centres = m.occupiedVoxelCentres();
+	ASSERT_EQ(pts.size(), centres.size());
+	double worst = 0;
+	for (std::size_t i = 0; i < pts.size(); i++) worst = std::max(worst, (T_world_floor.composePoint(pts[i]) - centres[i]).norm());
+	EXPECT_LT(worst, 1e-5);
 }
 
 TEST(SubmappedIo, InsertsTheRealKinectFrameOfTestsRgbdRawlog)

@@ -55,3 +55,44 @@ TEST(MetricMaps, UnknownMapTypeIsNamed)
 	mrpt::config::CConfigFileMemory bad("[maps]\nism2d_input = sometimes\n");
 	EXPECT_THROW(feed.loadFromConfigFile(bad, "maps"), std::invalid_argument);
 }
+
+TEST(MetricMaps, EveryTwoDimensionalGridTakesTheRunsFloorFrame)
+{
+	// Given in [floor]: the 2D grid's floor is that pose from the start.
+	mrpt::config::CConfigFileMemory ini(
+		"[MappingApplication]\nismOccupancyGrid2D_count = 1\nsubmappedOccupancyGrid3D_count = 1\n");
+	maps::FloorFrameOptions floor;
+	floor.givenPose = "[0.1 1.2 0.3 0 -90 90]";
+	const slam::MetricMaps given(ini, {}, floor);
+	ASSERT_TRUE(given.T_world_floor());
+	EXPECT_TRUE(given.floor().given());
+	const auto* ism = given.maps().mapByClass<CISMOccupancyGrid2D>().get();
+	ASSERT_TRUE(ism);
+	EXPECT_TRUE(ism->externalFloor());
+	EXPECT_TRUE(ism->floorKnown());
+	EXPECT_LT((ism->floorPose().asTPose() - given.T_world_floor()->asTPose()).norm(), 1e-12);
+	EXPECT_NE(given.floor().toJson().find("\"source\": \"given\""), std::string::npos);
+
+	// Estimated: unknown until the first keyframes, and the grid does not estimate its own.
+	const slam::MetricMaps estimated(ini, {});
+	EXPECT_FALSE(estimated.T_world_floor());
+	const auto* ism2 = estimated.maps().mapByClass<CISMOccupancyGrid2D>().get();
+	ASSERT_TRUE(ism2);
+	EXPECT_FALSE(ism2->floorKnown());
+	EXPECT_NE(estimated.floor().toJson().find("\"source\": \"none\""), std::string::npos);
+
+	// A floor pose of the grid's own would be silently replaced: refused, naming the key.
+	mrpt::config::CConfigFileMemory own(
+		"[MappingApplication]\nismOccupancyGrid2D_count = 1\n"
+		"[MappingApplication_ismOccupancyGrid2D_00_insertOpts]\nT_world_floor = [0 0 -1 0 0 0]\n");
+	try
+	{
+		slam::MetricMaps m(own, {});
+		FAIL() << "a grid's own T_world_floor must not be ignored";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("[floor] T_world_floor"), std::string::npos) << e.what();
+		EXPECT_NE(std::string(e.what()).find("_insertOpts] T_world_floor"), std::string::npos) << e.what();
+	}
+}

@@ -3,6 +3,7 @@
 // rawlog-edit loading libkeygrid_maps.so. One short synthetic run (keygrid-sim room_arc cut
 // to 40 frames, keygrid-slam config/sim.ini) feeds every test.
 #include <keygrid/core/TumTrajectory.h>
+#include <keygrid/maps/ExportFrame.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/io/CFileGZInputStream.h>
@@ -18,6 +19,9 @@
 #include <mrpt/opengl/CSetOfLines.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
+#include <mrpt/poses/CPose3DQuat.h>
+#include <keygrid/maps/CHOCPointsMap.h>
+#include <octomap/OcTree.h>
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/CDirectoryExplorer.h>
 #include <mrpt/system/filesystem.h>
@@ -25,7 +29,10 @@
 #include "SimSlamRun.h"
 #include "TestData.h"
 
+#include <algorithm>
 #include <fstream>
+#include <optional>
+#include <sstream>
 #include <map>
 #include <regex>
 #include <set>
@@ -94,6 +101,35 @@ void loadGz(const std::string& path, T& obj)
 {
 	mrpt::io::CFileGZInputStream f(path);
 	mrpt::serialization::archiveFrom(f) >> obj;
+}
+
+/** The 7 numbers "x y z qx qy qz qw" after `key` (JSON array or space separated). */
+std::optional<mrpt::poses::CPose3D> poseAfter(const std::string& text, const std::string& key)
+{
+	const auto at = text.find(key);
+	if (at == std::string::npos) return std::nullopt;
+	std::string rest = text.substr(at + key.size(), 300);
+	for (auto& c : rest)
+		if (c == '[' || c == ']' || c == ',') c = ' ';
+	std::istringstream is(rest);
+	double x, y, z, qx, qy, qz, qw;
+	if (!(is >> x >> y >> z >> qx >> qy >> qz >> qw)) return std::nullopt;
+	return mrpt::poses::CPose3D(mrpt::poses::CPose3DQuat(x, y, z, mrpt::math::CQuaternionDouble(qw, qx, qy, qz)));
+}
+
+/** report.json's floor frame ("floor": {..., "T_world_floor": [x y z qx qy qz qw]}). */
+std::optional<mrpt::poses::CPose3D> reportFloorPose(const std::string& report)
+{
+	const auto at = report.find("\"floor\": {");
+	if (at == std::string::npos) return std::nullopt;
+	return poseAfter(report.substr(at), "\"T_world_floor\": ");
+}
+
+/** The share of `v` below `q`-quantile: the q-quantile of the values. */
+double quantile(std::vector<double> v, double q)
+{
+	std::sort(v.begin(), v.end());
+	return v.empty() ? 0.0 : v[static_cast<std::size_t>(q * static_cast<double>(v.size() - 1))];
 }
 
 void expectNoTemporaryFiles(const std::string& out)
@@ -219,7 +255,7 @@ void checkScene(const std::string& out)
 	EXPECT_LT((gridPose.getRotationMatrix() - mrpt::math::CMatrixDouble33::Identity()).norm(), 1e-9);
 	auto voxels = grid3d->getByClass<mrpt::opengl::CPointCloud>();
 	ASSERT_TRUE(voxels);
-	// The same voxel centres as map_3d.ply (same order), moved into the display frame.
+	// The same voxel centres as map_3d.ply (same order): both in the floor frame.
 	const auto ply = plyPoints(out + "/map_3d.ply");
 	EXPECT_GT(ply.size(), 1000u);
 	ASSERT_EQ(voxels->size(), ply.size());
@@ -227,9 +263,13 @@ void checkScene(const std::string& out)
 	for (std::size_t k = 0; k < ply.size(); k++)
 	{
 		const auto& q = voxels->getPoint3Df(k);
-		worst = std::max(worst, (T_display_world.composePoint(ply[k]) - mrpt::math::TPoint3D(q.x, q.y, q.z)).norm());
+		worst = std::max(worst, (ply[k] - mrpt::math::TPoint3D(q.x, q.y, q.z)).norm());
 	}
 	EXPECT_LT(worst, 1e-3);
+	// The display frame is the run's floor frame of report.json.
+	const auto T_world_floor = reportFloorPose(report);
+	ASSERT_TRUE(T_world_floor);
+	EXPECT_LT(((-*T_world_floor).asTPose() - T_display_world.asTPose()).norm(), 1e-6);
 }
 }  // namespace
 
@@ -285,7 +325,12 @@ TEST(Outputs, ObservationsToMapRebuildsThe3DGridFromKeyframesSimplemap)
 	// only where keygrid-slam integrated a keyframe at its online pose before the final
 	// refinement moved it (and in the travelled distance, from all frames vs. keyframes).
 	// Measured 2026-11-21: 11252 vs 11199 occupied voxels, Jaccard 0.979.
-	const auto ownPts = plyPoints(out + "/map_3d.ply"), rebuiltPts = plyPoints(rebuilt);
+	// map_3d.ply is in the floor frame (its comment line), observations2map's in the world.
+	auto ownPts = plyPoints(out + "/map_3d.ply");
+	const auto rebuiltPts = plyPoints(rebuilt);
+	const auto T_world_floor = poseAfter(test::readTextFile(out + "/map_3d.ply"), "comment keygrid T_world_floor (x y z qx qy qz qw): ");
+	ASSERT_TRUE(T_world_floor);
+	for (auto& p : ownPts) p = T_world_floor->composePoint(p);
 	const auto own = voxelsOf(ownPts, 0.05), re = voxelsOf(rebuiltPts, 0.05);
 	ASSERT_EQ(own.size(), ownPts.size());  // distinct voxels
 	ASSERT_EQ(re.size(), rebuiltPts.size());
@@ -295,6 +340,104 @@ TEST(Outputs, ObservationsToMapRebuildsThe3DGridFromKeyframesSimplemap)
 	for (const auto& v : re) common += own.count(v);
 	const double jaccard = static_cast<double>(common) / (own.size() + re.size() - common);
 	EXPECT_GT(jaccard, 0.85);
+}
+
+TEST(Outputs, MapOutputsShareTheEstimatedFloorFrame)
+{
+	// Issue 26: one T_world_floor (z up, z = 0 on the floor) for every output. The sim world
+	// is z up with the floor at z = 0 and the SLAM world is the first camera's frame, so the
+	// true floor in the SLAM world is inverse(T_sim_cam0) of the sim's z = 0.
+	const std::string out = runSlamOnShortSimSequence();
+	ASSERT_FALSE(out.empty());
+	const std::string report = test::readTextFile(out + "/report.json");
+	EXPECT_NE(report.find("\"floor\": {\"source\": \"estimated\""), std::string::npos);
+	const auto T_world_floor = reportFloorPose(report);
+	ASSERT_TRUE(T_world_floor);
+	const auto gt = core::readTumTrajectory(mrpt::system::extractFileDirectory(out) + "/seq/groundtruth.txt");
+	ASSERT_FALSE(gt.empty());
+	const mrpt::poses::CPose3D T_sim_floor = gt.front().T_world_cam + *T_world_floor;
+	EXPECT_NEAR(T_sim_floor.z(), 0.0, 0.02);
+	EXPECT_GT(T_sim_floor.getRotationMatrix()(2, 2), std::cos(1.0 * M_PI / 180.0));
+
+	// Every map file records the same frame.
+	const std::string comment = maps::floorFrameComment(*T_world_floor);
+	EXPECT_NE(test::readTextFile(out + "/map_3d.ply").find("comment " + comment + "\n"), std::string::npos);
+	EXPECT_NE(test::readTextFile(out + "/hoc_points.ply").find("comment " + comment + "\n"), std::string::npos);
+	EXPECT_EQ(test::readTextFile(out + "/map_2d.yaml").rfind("# " + comment + "\n", 0), 0u);
+	{
+		std::ifstream bt(out + "/map_3d.bt");
+		std::string first, second;
+		std::getline(bt, first);
+		std::getline(bt, second);
+		EXPECT_EQ(second, "# " + comment);
+		octomap::OcTree tree(0.1);
+		EXPECT_TRUE(tree.readBinary(out + "/map_3d.bt"));
+		EXPECT_DOUBLE_EQ(tree.getResolution(), 0.05);
+	}
+
+	// map_3d.ply: the floor's voxels are the lowest, at z ~ 0 (one 5 cm voxel), the walls
+	// reach up to the 2.5 m ceiling; z is up.
+	const auto ply = plyPoints(out + "/map_3d.ply");
+	ASSERT_GT(ply.size(), 1000u);
+	std::vector<double> z;
+	for (const auto& p : ply) z.push_back(p.z);
+	EXPECT_NEAR(quantile(z, 0.005), 0.0, 0.05);
+	EXPECT_GT(quantile(z, 0.99), 1.5);
+	EXPECT_LT(quantile(z, 1.0), 2.6);
+
+	// hoc_points.ply: the landmarks of hoc_points.bin (SLAM world) moved into the floor frame.
+	keygrid::CHOCPointsMap hoc;
+	loadGz(out + "/hoc_points.bin", hoc);
+	const auto hocPly = plyPoints(out + "/hoc_points.ply");
+	ASSERT_EQ(hocPly.size(), hoc.size());
+	ASSERT_GT(hocPly.size(), 100u);
+	double worst = 0;
+	std::vector<double> hz;
+	for (std::size_t i = 0; i < hocPly.size(); i++)
+	{
+		worst = std::max(worst, (T_world_floor->composePoint(hocPly[i]) - hoc.points()[i].p).norm());
+		hz.push_back(hocPly[i].z);
+	}
+	EXPECT_LT(worst, 1e-4);
+	EXPECT_GT(quantile(hz, 0.01), -0.05);
+
+	// trajectory_floor.txt: T_floor_cam of every frame; the sim camera flies at 1.3 m.
+	const auto traj = core::readTumTrajectory(out + "/trajectory.txt");
+	const auto trajFloor = core::readTumTrajectory(out + "/trajectory_floor.txt");
+	ASSERT_EQ(traj.size(), trajFloor.size());
+	for (std::size_t i = 0; i < traj.size(); i++)
+	{
+		const mrpt::poses::CPose3D expected = -*T_world_floor + traj[i].T_world_cam;
+		EXPECT_LT((trajFloor[i].T_world_cam.translation() - expected.translation()).norm(), 1e-4);
+		EXPECT_NEAR(trajFloor[i].T_world_cam.z(), 1.3, 0.03);
+	}
+}
+
+TEST(Outputs, FloorFrameExistsWithOnlyThe3DGrid)
+{
+	// The floor estimate belongs to the run, not to the 2D grid: with the 3D grid alone, its
+	// files are in the floor frame all the same.
+	const std::string dir = test::scratchDir("outputs_floor_3d_only");
+	auto run = test::renderAndRunSlam(
+		dir, "--scene " + test::dataDir() + "/sim/room_arc.ini --frames 40 --voxel-resolution 0 --floorplan-resolution 0", false);
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	auto o = run.options;
+	o.output = dir + "/out3d";
+	o.set = "MappingApplication.ismOccupancyGrid2D_count = 0; MappingApplication.hocPointsMap_count = 0";
+	const auto r = slam::runSlam(o);
+	ASSERT_TRUE(r.error.empty()) << r.error;
+	EXPECT_FALSE(mrpt::system::fileExists(o.output + "/map_2d.yaml"));
+	const auto T_world_floor = reportFloorPose(test::readTextFile(o.output + "/report.json"));
+	ASSERT_TRUE(T_world_floor);
+	const auto gt = core::readTumTrajectory(dir + "/seq/groundtruth.txt");
+	const mrpt::poses::CPose3D T_sim_floor = gt.front().T_world_cam + *T_world_floor;
+	EXPECT_NEAR(T_sim_floor.z(), 0.0, 0.02);
+	EXPECT_GT(T_sim_floor.getRotationMatrix()(2, 2), std::cos(1.0 * M_PI / 180.0));
+	EXPECT_NE(test::readTextFile(o.output + "/map_3d.ply").find("comment " + maps::floorFrameComment(*T_world_floor)), std::string::npos);
+	std::vector<double> z;
+	for (const auto& p : plyPoints(o.output + "/map_3d.ply")) z.push_back(p.z);
+	ASSERT_GT(z.size(), 1000u);
+	EXPECT_NEAR(quantile(z, 0.005), 0.0, 0.05);
 }
 
 TEST(Outputs, RawlogEditLoadsTheMapsPlugin)

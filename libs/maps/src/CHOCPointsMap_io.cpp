@@ -107,11 +107,13 @@ void CHOCPointsMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t ver
 	}
 }
 
-void CHOCPointsMap::saveAsPly(const std::string& path) const
+void CHOCPointsMap::saveAsPly(const std::string& path, const maps::ExportFrame& frame) const
 {
 	std::ofstream f(path);
 	if (!f) throw std::runtime_error("cannot write '" + path + "'");
 	f << "ply\nformat ascii 1.0\ncomment keygrid CHOCPointsMap: colour and weight = largest HOC bin weight\n";
+	if (!frame.comment.empty()) f << "comment " << frame.comment << "\n";
+	const bool move = !frame.isIdentity();
 	f << "element vertex " << m_points.size() << "\n";
 	f << "property float x\nproperty float y\nproperty float z\n";
 	f << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
@@ -122,7 +124,8 @@ void CHOCPointsMap::saveAsPly(const std::string& path) const
 		const auto& p = m_points[i];
 		const double w = maxWeight(i);
 		const auto c = weightColour(w);
-		std::snprintf(line, sizeof(line), "%.5f %.5f %.5f %d %d %d %.4f %d\n", p.p.x, p.p.y, p.p.z, static_cast<int>(255 * c.R),
+		const auto q = move ? frame.T_out_world.composePoint(p.p) : p.p;
+		std::snprintf(line, sizeof(line), "%.5f %.5f %.5f %d %d %d %.4f %d\n", q.x, q.y, q.z, static_cast<int>(255 * c.R),
 					  static_cast<int>(255 * c.G), static_cast<int>(255 * c.B), w, positiveObservations(p.hoc));
 		f << line;
 	}

@@ -421,6 +421,7 @@ bool CISMOccupancyGrid2D::ensureFloorFromDepth(
 	const CPose3D& T_world_cam, const mrpt::obs::CObservation3DRangeScan& obs)
 {
 	if (floorKnown()) return true;
+	if (m_floorExternal) return false;  // waits for setExternalFloorPose()
 	const auto pts_cam = depthToCameraPoints(obs, 4);
 	std::vector<TPoint3D> pts_world;
 	pts_world.reserve(pts_cam.size());
@@ -444,6 +445,20 @@ bool CISMOccupancyGrid2D::estimateFloorFromPoints(
 	m_T_world_floorEstimate = maps::floorPoseFromPlane(*plane, cam, fwd);
 	m_floorEstimated = true;
 	return true;
+}
+
+void CISMOccupancyGrid2D::expectExternalFloorPose()
+{
+	if (m_floorExternal) return;
+	m_floorExternal = true;
+	m_floorEstimated = false;
+}
+
+void CISMOccupancyGrid2D::setExternalFloorPose(const CPose3D& T_world_floor)
+{
+	m_floorExternal = true;
+	m_floorEstimated = true;
+	m_T_world_floorEstimate = T_world_floor;
 }
 
 bool CISMOccupancyGrid2D::insertKeyframeDepth(

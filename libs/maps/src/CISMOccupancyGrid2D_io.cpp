@@ -3,6 +3,7 @@
  * and the 3D visualization.
  */
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
+#include <keygrid/maps/ExportFrame.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/math/CQuaternion.h>
 #include <mrpt/opengl/CSetOfObjects.h>
@@ -95,7 +96,7 @@ void CISMOccupancyGrid2D::serializeTo(CArchive& out) const
 		}
 	}
 	out << m_nextAutoKeyframeId << m_lastRebuildSeconds;
-	out << static_cast<int32_t>(m_bandSlices) << m_band;
+	out << static_cast<int32_t>(m_bandSlices) << m_band << m_floorExternal;  // since version 1
 }
 
 void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
@@ -138,10 +139,11 @@ void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
 			in >> m_nextAutoKeyframeId >> m_lastRebuildSeconds;
 			m_band.clear();
 			m_bandSlices = 0;
+			m_floorExternal = false;
 			if (version >= 1)
 			{
 				int32_t slices = 0;
-				in >> slices >> m_band;
+				in >> slices >> m_band >> m_floorExternal;
 				if (!m_band.empty() && (slices < 1 || slices > 64 || m_band.size() != m_logOdds.size() * static_cast<size_t>(slices + 1)))
 					throw std::runtime_error("CISMOccupancyGrid2D: serialized height band size mismatch");
 				m_bandSlices = m_band.empty() ? 0 : slices;
@@ -190,12 +192,7 @@ void CISMOccupancyGrid2D::saveAsRosMapServer(const std::string& yamlPath) const
 	// The floor frame in the world (a comment: map_server and MRPT ignore it), so that a map
 	// whose floor was estimated can be compared with a ground truth in another frame. First
 	// line: libfyaml 0.8 (MRPT's YAML reader) leaks its input buffer on a trailing comment.
-	mrpt::math::CQuaternionDouble q;
-	const auto& F = floorPose();
-	F.getAsQuaternion(q);
-	std::snprintf(buf, sizeof(buf), "# keygrid T_world_floor (x y z qx qy qz qw): %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
-		F.x(), F.y(), F.z(), q.x(), q.y(), q.z(), q.r());
-	yaml << buf;
+	yaml << "# " << maps::floorFrameComment(floorPose()) << "\n";
 	std::snprintf(buf, sizeof(buf),
 		"image: %s\nresolution: %.9g\norigin: [%.9g, %.9g, 0.0]\nnegate: 0\n"
 		"occupied_thresh: 0.65\nfree_thresh: 0.196\n",

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 using namespace keygrid;
@@ -248,13 +249,37 @@ void CSubmappedOccupancyGrid3D::serializeFrom(mrpt::serialization::CArchive& in,
 }
 
 // ---------------------------------------------------------------- exports
-void CSubmappedOccupancyGrid3D::saveAsOctomapBinary(const std::string& path) const
+namespace
+{
+/** Calls f(outIndex, voxel) for every voxel of an output lattice (same resolution, frame
+ * T_out_world) whose centre lies in a known voxel of g, with that voxel (nearest-neighbour
+ * resampling). A centre lies in exactly one world voxel, and that voxel's own centre maps to
+ * within half a voxel diagonal of it, i.e. into one of the 27 output voxels around the
+ * voxel holding the mapped centre: those 27 are tested per known world voxel. */
+template <class F>
+void forEachResampled(const VoxelBlockGrid& g, const mrpt::poses::CPose3D& T_out_world, F&& f)
+{
+	const mrpt::poses::CPose3D T_world_out = -T_out_world;
+	g.forEachKnown([&](const VoxelIndex& vi, const Voxel& v) {
+		const VoxelIndex k = g.voxelOf(T_out_world.composePoint(g.centreOf(vi)));
+		for (int dz = -1; dz <= 1; ++dz)
+			for (int dy = -1; dy <= 1; ++dy)
+				for (int dx = -1; dx <= 1; ++dx)
+				{
+					const VoxelIndex o{k.x + dx, k.y + dy, k.z + dz};
+					if (g.voxelOf(T_world_out.composePoint(g.centreOf(o))) == vi) f(o, v);
+				}
+	});
+}
+}  // namespace
+
+void CSubmappedOccupancyGrid3D::saveAsOctomapBinary(const std::string& path, const maps::ExportFrame& frame) const
 {
 	const VoxelBlockGrid g = fusedGrid();
 	octomap::OcTree tree(m_resolution);
 	constexpr int32_t kHalf = 32768;  // OcTree key of coordinate x is floor(x / res) + 32768
 	std::size_t outside = 0;
-	g.forEachKnown([&](const VoxelIndex& vi, const Voxel& v) {
+	auto put = [&](const VoxelIndex& vi, const Voxel& v) {
 		if (vi.x < -kHalf || vi.x >= kHalf || vi.y < -kHalf || vi.y >= kHalf || vi.z < -kHalf ||
 			vi.z >= kHalf)
 		{
@@ -266,25 +291,39 @@ void CSubmappedOccupancyGrid3D::saveAsOctomapBinary(const std::string& path) con
 		// OctoMap calls log-odds >= 0 occupied, keygrid > 0: keep p = 0.5 exactly free.
 		const float L = v.logOdds > 0.0f ? v.logOdds : std::min(v.logOdds, -1e-4f);
 		tree.setNodeValue(key, L, true);
-	});
+	};
+	if (frame.isIdentity())
+		g.forEachKnown(put);
+	else
+		forEachResampled(g, frame.T_out_world, put);
 	if (outside > 0)
 		throw std::runtime_error(
 			"saveAsOctomapBinary: " + std::to_string(outside) +
 			" voxels lie outside the OcTree key range (+-32768 voxels)");
 	tree.updateInnerOccupancy();
-	if (!tree.writeBinary(path))
-		throw std::runtime_error("saveAsOctomapBinary: cannot write '" + path + "'");
+	// OctoMap's header: a first line it checks, then keyword lines; it skips lines starting
+	// with '#' (AbstractOcTree::readHeader), so the frame goes in as the second line.
+	std::ostringstream bt;
+	if (!tree.writeBinary(bt)) throw std::runtime_error("saveAsOctomapBinary: cannot serialize the tree");
+	std::string data = bt.str();
+	if (!frame.comment.empty()) data.insert(data.find('\n') + 1, "# " + frame.comment + "\n");
+	std::ofstream f(path, std::ios::binary);
+	f.write(data.data(), static_cast<std::streamsize>(data.size()));
+	if (!f) throw std::runtime_error("saveAsOctomapBinary: cannot write '" + path + "'");
 }
 
-void CSubmappedOccupancyGrid3D::saveOccupiedAsPly(const std::string& path) const
+void CSubmappedOccupancyGrid3D::saveOccupiedAsPly(const std::string& path, const maps::ExportFrame& frame) const
 {
-	const auto pts = occupiedVoxelCentres();
+	auto pts = occupiedVoxelCentres();
+	if (!frame.isIdentity())
+		for (auto& p : pts) p = frame.T_out_world.composePoint(p);
 	std::ofstream f(path);
 	if (!f) throw std::runtime_error("saveOccupiedAsPly: cannot write '" + path + "'");
 	f << "ply\nformat ascii 1.0\ncomment keygrid CSubmappedOccupancyGrid3D occupied voxel "
 		 "centres, resolution "
-	  << m_resolution << " m\nelement vertex " << pts.size()
-	  << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+	  << m_resolution << " m\n";
+	if (!frame.comment.empty()) f << "comment " << frame.comment << "\n";
+	f << "element vertex " << pts.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
 	for (const auto& p : pts) f << float(p.x) << ' ' << float(p.y) << ' ' << float(p.z) << '\n';
 	if (!f) throw std::runtime_error("saveOccupiedAsPly: error writing '" + path + "'");
 }

@@ -18,15 +18,11 @@ void MapFeedOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, 
 	ism2dInput = c.read_string(s, "ism2d_input", ism2dInput);
 	if (ism2dInput != "sparse" && ism2dInput != "dense")
 		throw std::invalid_argument("[" + s + "] ism2d_input = '" + ism2dInput + "' (expected sparse or dense)");
-	floorKeyframes = c.read_int(s, "floor_keyframes", floorKeyframes);
-	if (floorKeyframes < 1)
-		throw std::invalid_argument("[" + s + "] floor_keyframes = " + std::to_string(floorKeyframes) + " (must be >= 1)");
 }
 
 void MapFeedOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
 	c.write(s, "ism2d_input", ism2dInput, 30, 40, "sparse (map points) | dense (depth image)");
-	c.write(s, "floor_keyframes", floorKeyframes, 30, 40, "2D grid: first keyframes whose depth samples estimate the floor together");
 }
 
 namespace
@@ -41,25 +37,6 @@ bool knownMapType(const std::string& name)
 			if (part == name) return true;
 	}
 	return false;
-}
-
-/** Floor-estimate samples of a keyframe: its depth on a coarse pixel lattice (every kStep-th
- * pixel, depth in [kMinDepth, kMaxDepth] m, lens distortion ignored), in the world frame. Depth
- * samples the floor evenly; map points sit on texture, and few on a floor seen at a grazing
- * angle, so they often miss it. */
-void appendDepthSamples(const sfm::KeyFrame& kf, std::vector<mrpt::math::TPoint3D>& out)
-{
-	constexpr int kStep = 12;
-	constexpr float kMinDepth = 0.3f, kMaxDepth = 4.0f;
-	const auto& cam = kf.features.camera;
-	for (int r = kStep / 2; r < kf.depth.rows; r += kStep)
-		for (int c = kStep / 2; c < kf.depth.cols; c += kStep)
-		{
-			const float z = kf.depth.at<float>(r, c);
-			if (!(z >= kMinDepth && z <= kMaxDepth)) continue;
-			out.push_back(kf.T_world_cam.composePoint(
-				mrpt::math::TPoint3D((c - cam.cx) * z / cam.fx, (r - cam.cy) * z / cam.fy, z)));
-		}
 }
 
 /** A depth-only observation of a keyframe, for MRPT's own maps. */
@@ -108,7 +85,9 @@ CHOCPointsMap hocPointsFromLandmarks(const sfm::SparseMap& map, const maps::HocO
 	return m;
 }
 
-MetricMaps::MetricMaps(const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed) : m_feed(feed)
+MetricMaps::MetricMaps(
+	const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed, const maps::FloorFrameOptions& floor)
+	: m_feed(feed), m_floor(floor)
 {
 	if (!cfg.sectionExists(kSection)) return;
 	std::vector<std::string> keys;
@@ -133,6 +112,39 @@ MetricMaps::MetricMaps(const mrpt::config::CConfigFileBase& cfg, const MapFeedOp
 		throw std::invalid_argument(
 			std::string("[") + kSection + "] asks for " + std::to_string(requested) + " maps but " +
 			std::to_string(m_maps.maps.size()) + " were created");
+	// Every 2D grid takes the run's floor frame. A grid's own floor pose would be silently
+	// replaced: refuse it, naming where the floor of a keygrid-slam run is given.
+	for (std::size_t i = 0; i < m_maps.maps.size(); i++)
+		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m_maps.maps[i].get()))
+		{
+			const auto& io = ism->insertionOptions;
+			if (!io.estimateFloorFromDepth && !maps::ExportFrame{io.T_world_floor, {}}.isIdentity())
+				throw std::invalid_argument(
+					std::string("[") + kSection + "_ismOccupancyGrid2D_" + (i < 10 ? "0" : "") + std::to_string(i) +
+					"_insertOpts] T_world_floor: keygrid-slam gives every map the run's one floor frame; set it as "
+					"[floor] T_world_floor instead");
+			if (m_floor.T_world_floor())
+				ism->setExternalFloorPose(*m_floor.T_world_floor());
+			else
+				ism->expectExternalFloorPose();
+		}
+}
+
+void MetricMaps::floorChanged()
+{
+	for (auto& m : m_maps.maps)
+		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
+		{
+			ism->setExternalFloorPose(*m_floor.T_world_floor());
+			// The keyframes integrated so far, again in the new floor frame (cheap).
+			if (!ism->keyframes().empty()) ism->applyTrajectoryCorrection({});
+		}
+}
+
+maps::ExportFrame MetricMaps::outputFrame() const
+{
+	if (m_floor.T_world_floor()) return maps::floorExportFrame(*m_floor.T_world_floor());
+	return {mrpt::poses::CPose3D(), "keygrid frame: SLAM world (the first camera's optical frame; no floor estimate)"};
 }
 
 void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, double travelled)
@@ -140,51 +152,58 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 	if (empty()) return;
 	const auto& kf = map.keyframe(id);
 	m_insertedPoses[id] = kf.T_world_cam;
-	mrpt::obs::CObservation3DRangeScan::Ptr obs;  // built on demand
-	for (auto& m : m_maps.maps)
+	// The floor first, so that the keyframe enters the 2D grids in the newest floor frame.
+	// Samples of its depth image, else its map points.
+	if (!m_floor.given())
 	{
+		std::vector<mrpt::math::TPoint3Df> samples;
+		if (!kf.depth.empty())
+		{
+			const cv::Mat d = kf.depth.isContinuous() ? kf.depth : kf.depth.clone();
+			const auto& cam = kf.features.camera;
+			samples = maps::FloorFrameEstimator::depthSamples(d.ptr<float>(), d.rows, d.cols, cam.fx, cam.fy, cam.cx, cam.cy, m_floor.options());
+		}
+		else
+			for (sfm::LandmarkId l : kf.landmarks)
+				if (l != sfm::kNoLandmark && map.hasLandmark(l))
+				{
+					const auto& p = map.landmark(l).p_world;
+					const auto q = kf.T_world_cam.inverseComposePoint(mrpt::math::TPoint3D(p.x(), p.y(), p.z()));
+					samples.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
+				}
+		if (m_floor.addKeyframe(id, kf.T_world_cam, samples, kf.timestamp)) floorChanged();
+	}
+	mrpt::obs::CObservation3DRangeScan::Ptr obs;  // built on demand
+	for (std::size_t i = 0; i < m_maps.maps.size(); i++)
+	{
+		auto& m = m_maps.maps[i];
 		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
 		{
-			const bool dense = m_feed.ism2dInput == "dense" && !kf.depth.empty();
-			std::vector<mrpt::math::TPoint3D> pts;
-			if (!dense)
-				for (sfm::LandmarkId l : kf.landmarks)
-					if (l != sfm::kNoLandmark && map.hasLandmark(l))
-					{
-						const auto& p = map.landmark(l).p_world;
-						pts.emplace_back(p.x(), p.y(), p.z());
-					}
-			bool rebuild = false;
-			// The floor from the first keyframes together (it is often out of view at the first):
-			// until it is found, and then for floor_keyframes keyframes in all. Samples of the
-			// depth image where there is one, else the keyframe's map points.
-			constexpr std::size_t kMaxFloorPoints = 200000;
-			if (ism->insertionOptions.estimateFloorFromDepth && (!ism->floorKnown() || m_floorKeyframes < m_feed.floorKeyframes) &&
-				m_floorPoints.size() < kMaxFloorPoints)
+			if (m_feed.ism2dInput == "dense" && !kf.depth.empty())
 			{
-				if (!m_firstKeyframePose) m_firstKeyframePose = kf.T_world_cam;
-				if (!kf.depth.empty())
-					appendDepthSamples(kf, m_floorPoints);
-				else
-					m_floorPoints.insert(m_floorPoints.end(), pts.begin(), pts.end());
-				m_floorKeyframes++;
-				// "Up" hint: the mean -y axis of these keyframes. A hand-held camera pitches up
-				// and down; the mean is nearer the true up than the first camera alone.
-				m_floorUpSum = m_floorUpSum + kf.T_world_cam.rotateVector(mrpt::math::TVector3D(0, -1, 0));
-				const bool known = ism->floorKnown();
-				const auto before = ism->floorPose();
-				if (ism->estimateFloorFromPoints(m_floorPoints, *m_firstKeyframePose, m_floorUpSum) && known)
-					rebuild = (ism->floorPose().asTPose() - before.asTPose()).norm() > 1e-9;
-			}
-			if (dense)
-			{
+				// Dense input is reduced in the floor frame: it waits for the floor.
+				auto& pending = m_pendingDense[i];
+				if (!ism->floorKnown())
+				{
+					pending.push_back(id);
+					continue;
+				}
+				for (sfm::KeyFrameId p : pending)
+					if (map.hasKeyFrame(p)) ism->insertKeyframeDepth(p, map.keyframe(p).T_world_cam, *depthObservation(map.keyframe(p)));
+				pending.clear();
 				if (!obs) obs = depthObservation(kf);
 				ism->insertKeyframeDepth(id, kf.T_world_cam, *obs);
+				continue;
 			}
-			else
-				ism->insertKeyframePoints(id, kf.T_world_cam, pts);
-			// A better floor: the keyframes inserted so far are integrated again (cheap).
-			if (rebuild) ism->applyTrajectoryCorrection({});
+			// Sparse input is stored also before the floor is known, and integrated then.
+			std::vector<mrpt::math::TPoint3D> pts;
+			for (sfm::LandmarkId l : kf.landmarks)
+				if (l != sfm::kNoLandmark && map.hasLandmark(l))
+				{
+					const auto& p = map.landmark(l).p_world;
+					pts.emplace_back(p.x(), p.y(), p.z());
+				}
+			ism->insertKeyframePoints(id, kf.T_world_cam, pts);
 		}
 		else if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get()))
 		{
@@ -203,6 +222,15 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses)
 {
 	std::map<std::string, double> out;
+	{
+		// The floor under the corrected poses; the 2D grids are rebuilt below anyway.
+		const auto t0 = std::chrono::steady_clock::now();
+		std::map<uint64_t, mrpt::poses::CPose3D> np(newPoses.begin(), newPoses.end());
+		if (m_floor.updatePoses(np))
+			for (auto& m : m_maps.maps)
+				if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get())) ism->setExternalFloorPose(*m_floor.T_world_floor());
+		out["floor"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+	}
 	for (auto& m : m_maps.maps)
 	{
 		const auto t0 = std::chrono::steady_clock::now();
@@ -279,6 +307,7 @@ std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const
 
 std::vector<std::string> MetricMaps::writeOutputsInto(const std::string& dir) const
 {
+	const maps::ExportFrame frame = outputFrame();
 	std::vector<std::string> files;
 	std::map<std::string, int> seen;
 	for (const auto& m : m_maps.maps)
@@ -295,14 +324,14 @@ std::vector<std::string> MetricMaps::writeOutputsInto(const std::string& dir) co
 		}
 		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
 		{
-			g3->saveAsOctomapBinary(dir + "/map_3d" + suffix + ".bt");
-			g3->saveOccupiedAsPly(dir + "/map_3d" + suffix + ".ply");
+			g3->saveAsOctomapBinary(dir + "/map_3d" + suffix + ".bt", frame);
+			g3->saveOccupiedAsPly(dir + "/map_3d" + suffix + ".ply", frame);
 			saveGzAtomically(*g3, dir + "/map_3d" + suffix + ".bin");
 			files.insert(files.end(), {"map_3d" + suffix + ".bt", "map_3d" + suffix + ".ply", "map_3d" + suffix + ".bin"});
 		}
 		else if (const auto* hoc = dynamic_cast<const CHOCPointsMap*>(m.get()))
 		{
-			hoc->saveAsPly(dir + "/hoc_points" + suffix + ".ply");
+			hoc->saveAsPly(dir + "/hoc_points" + suffix + ".ply", frame);
 			saveGzAtomically(*hoc, dir + "/hoc_points" + suffix + ".bin");
 			files.insert(files.end(), {"hoc_points" + suffix + ".ply", "hoc_points" + suffix + ".bin"});
 		}

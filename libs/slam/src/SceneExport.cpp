@@ -1,5 +1,4 @@
 #include <keygrid/core/FrameConventions.h>
-#include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/slam/SceneExport.h>
 #include <keygrid/slam/SimpleMapExport.h>
 #include <mrpt/opengl/CFrustum.h>
@@ -31,12 +30,9 @@ typename T::Ptr createInMrpt()
 }
 
 /** Pose that shows the world with +Z up (see header). */
-mrpt::poses::CPose3D displayFromWorld(const mrpt::maps::CMultiMetricMap* maps)
+mrpt::poses::CPose3D displayFromWorld(const std::optional<mrpt::poses::CPose3D>& T_world_floor)
 {
-	if (maps)
-		for (const auto& m : maps->maps)
-			if (const auto* ism = dynamic_cast<const CISMOccupancyGrid2D*>(m.get()); ism && ism->floorKnown())
-				return -ism->floorPose();  // p_floor = inv(T_world_floor) * p_world
+	if (T_world_floor) return -*T_world_floor;  // p_floor = inv(T_world_floor) * p_world
 	return core::T_depth_cam();  // p_mrpt = T_depth_cam * p_cam
 }
 
@@ -116,7 +112,7 @@ mrpt::opengl::CPointCloud::Ptr landmarkCloud(const sfm::SparseMap& map, float po
 
 mrpt::opengl::COpenGLScene::Ptr buildRunScene(
 	const core::Trajectory& trajectory, const sfm::SparseMap& map, const mrpt::maps::CMultiMetricMap* maps,
-	const SceneExportOptions& opts)
+	const std::optional<mrpt::poses::CPose3D>& T_world_floor, const SceneExportOptions& opts)
 {
 	auto scene = mrpt::opengl::COpenGLScene::Create();
 	auto ground = mrpt::opengl::CGridPlaneXY::Create(-10, 10, -10, 10, 0, 1);
@@ -126,7 +122,7 @@ mrpt::opengl::COpenGLScene::Ptr buildRunScene(
 
 	auto run = mrpt::opengl::CSetOfObjects::Create();
 	run->setName("keygrid_run");
-	const mrpt::poses::CPose3D T_display_world = displayFromWorld(maps);
+	const mrpt::poses::CPose3D T_display_world = displayFromWorld(T_world_floor);
 	run->setPose(T_display_world);
 	run->insert(trajectoryLine(trajectory, opts.trajectoryLineWidth));
 	run->insert(keyframeFrustums(map, opts.frustumDepth));
@@ -149,9 +145,9 @@ mrpt::opengl::COpenGLScene::Ptr buildRunScene(
 
 void writeRunScene(
 	const core::Trajectory& trajectory, const sfm::SparseMap& map, const mrpt::maps::CMultiMetricMap* maps,
-	const std::string& path, const SceneExportOptions& opts)
+	const std::optional<mrpt::poses::CPose3D>& T_world_floor, const std::string& path, const SceneExportOptions& opts)
 {
-	saveGzAtomically(*buildRunScene(trajectory, map, maps, opts), path);
+	saveGzAtomically(*buildRunScene(trajectory, map, maps, T_world_floor, opts), path);
 }
 
 }  // namespace keygrid::slam

@@ -30,6 +30,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	if (refinement.globalIterations < 1)
 		throw std::invalid_argument("[refinement] global_iterations = " + std::to_string(refinement.globalIterations) + " (must be >= 1)");
 	maps.loadFromConfigFile(c, "maps");
+	floor.loadFromConfigFile(c, "floor");
 	loop.loadFromConfigFile(c, "loop_closing");
 	// The depth residual model is shared by tracking and bundle adjustment.
 	mapping.ba.bf = tracker.pose.bf;
@@ -49,6 +50,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	c.write("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment, 30, 40, "bundle-adjust everything after the last frame");
 	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "upper bound on its iterations (it stops on convergence)");
 	maps.saveToConfigFile(c, "maps");
+	floor.saveToConfigFile(c, "floor");
 	loop.saveToConfigFile(c, "loop_closing");
 	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame that is not a keyframe against the final map");
 }

@@ -127,7 +127,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 
 	System sys(cfg);
 	{
-		auto maps = std::make_unique<MetricMaps>(ini, cfg.maps);
+		auto maps = std::make_unique<MetricMaps>(ini, cfg.maps, cfg.floor);
 		if (!maps->empty()) sys.attachMaps(std::move(maps));
 	}
 	SlamRunResult res;
@@ -229,6 +229,17 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 
 	const auto traj = sys.trajectory();
 	writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, "keygrid-slam trajectory, every frame"));
+	// The run's floor frame (any map configured): every map output is written in it.
+	const std::optional<mrpt::poses::CPose3D> T_world_floor =
+		sys.metricMaps() ? sys.metricMaps()->T_world_floor() : std::nullopt;
+	if (T_world_floor)
+	{
+		std::ostringstream t;
+		t << "# keygrid-slam trajectory in the floor frame (z up, z = 0 on the floor), every frame\n# "
+		  << maps::floorFrameComment(*T_world_floor) << "\n# timestamp tx ty tz qx qy qz qw  (T_floor_cam, optical frame)\n";
+		for (const auto& p : traj) t << core::tumLine({p.t, p.T_world_cam - *T_world_floor}) << "\n";
+		writeFileAtomically(o.output + "/trajectory_floor.txt", t.str());
+	}
 	{
 		// As tracked, before later map refinement (diagnostics: trajectory.txt is the final one).
 		core::Trajectory raw;
@@ -259,7 +270,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	}
 	try
 	{
-		writeRunScene(traj, sys.map(), sys.metricMaps() ? &sys.metricMaps()->maps() : nullptr, o.output + "/scene.3Dscene");
+		writeRunScene(traj, sys.map(), sys.metricMaps() ? &sys.metricMaps()->maps() : nullptr, T_world_floor, o.output + "/scene.3Dscene");
 	}
 	catch (const std::exception& e)
 	{
@@ -319,7 +330,8 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	{
 		try
 		{
-			hocPointsFromLandmarks(sys.map(), cfg.tracker.hoc).saveAsPly(o.output + "/hoc_points.ply.tmp");
+			hocPointsFromLandmarks(sys.map(), cfg.tracker.hoc)
+				.saveAsPly(o.output + "/hoc_points.ply.tmp", T_world_floor ? maps::floorExportFrame(*T_world_floor) : maps::ExportFrame{});
 			std::rename((o.output + "/hoc_points.ply.tmp").c_str(), (o.output + "/hoc_points.ply").c_str());
 		}
 		catch (const std::exception& e)
@@ -397,6 +409,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	}
 	js << "],\n";
 	js << "  \"maps\": " << (sys.metricMaps() ? sys.metricMaps()->summaryJson() : std::string("[]")) << ",\n";
+	js << "  \"floor\": " << (sys.metricMaps() ? sys.metricMaps()->floor().toJson() : std::string("null")) << ",\n";
 	{
 		char m[320];
 		const double kfs = std::max<std::size_t>(1, st.keyframesCreated);

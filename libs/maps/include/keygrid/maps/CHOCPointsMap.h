@@ -17,6 +17,7 @@
  *    and points whose largest bin weight is below prune_threshold are removed.
  *    tol = occlusion_tolerance_abs + occlusion_tolerance_rel * z.
  */
+#include <keygrid/maps/ExportFrame.h>
 #include <keygrid/maps/HocGeometry.h>
 #include <keygrid/maps/HocHistogram.h>
 #include <mrpt/config/CLoadableOptions.h>
@@ -107,8 +108,9 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap
 	std::size_t prune();
 
 	/** ASCII PLY: x y z, colour by weight, property `weight` (largest bin weight) and
-	 * `observations` (sum of positive counts). Throws std::runtime_error if not writable. */
-	void saveAsPly(const std::string& path) const;
+	 * `observations` (sum of positive counts). Throws std::runtime_error if not writable.
+	 * Points are mapped into `frame` (e.g. the floor frame); frame.comment is a PLY comment. */
+	void saveAsPly(const std::string& path, const maps::ExportFrame& frame = {}) const;
 
 	// CMetricMap / Stringifyable / Visualizable
 	bool isEmpty() const override { return m_points.empty(); }

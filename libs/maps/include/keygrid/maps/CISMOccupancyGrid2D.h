@@ -35,7 +35,8 @@ enum class CellState : uint8_t
  * Frames: the grid lives in the floor frame F (z up, z = 0 on the floor); its pose in the
  * world is insertionOptions.T_world_floor, or a RANSAC estimate of the floor plane from the
  * first depth image when insertionOptions.estimateFloorFromDepth is set (TUM's world frame is
- * not gravity aligned). A 3D point p_F is an obstacle when obstacleMinHeight <= z <=
+ * not gravity aligned), or set from outside (setExternalFloorPose: keygrid-slam hands every
+ * grid the run's one floor frame). A 3D point p_F is an obstacle when obstacleMinHeight <= z <=
  * obstacleMaxHeight, floor when |z| <= floorTolerance (it then only clears space), and ignored
  * otherwise. Every kept point casts a 2D ray from the camera's footprint to the point's
  * footprint; the cells on it are updated with l += logit(ISM(r)) - l0. With the default
@@ -221,8 +222,21 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 		const std::vector<mrpt::math::TPoint3D>& points_world,
 		const mrpt::poses::CPose3D& T_world_cam,
 		const std::optional<mrpt::math::TVector3D>& upHint = std::nullopt);
-	/** True once the floor frame is known (always when estimateFloorFromDepth is false). */
-	bool floorKnown() const { return !insertionOptions.estimateFloorFromDepth || m_floorEstimated; }
+	/** True once the floor frame is known (always when estimateFloorFromDepth is false and no
+	 * external floor is expected). */
+	bool floorKnown() const
+	{
+		return m_floorExternal ? m_floorEstimated : !insertionOptions.estimateFloorFromDepth || m_floorEstimated;
+	}
+	/** The floor frame comes from outside (keygrid-slam: the run's one floor frame,
+	 * maps::FloorFrameEstimator) and is not known yet: floorKnown() is false until
+	 * setExternalFloorPose(), and the grid never estimates a floor itself (its T_world_floor,
+	 * estimateFloorFromDepth, floorUpHint and floorRansac_* options are then unused). */
+	void expectExternalFloorPose();
+	/** Sets the floor frame from outside (see expectExternalFloorPose(), which this implies).
+	 * Keyframes integrated before keep the old floor until applyTrajectoryCorrection(). */
+	void setExternalFloorPose(const mrpt::poses::CPose3D& T_world_floor);
+	bool externalFloor() const { return m_floorExternal; }
 	/** @} */
 
 	/** @name Cell access (cell indices; (0,0) is the cell at (xMin, yMin))
@@ -249,11 +263,12 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	CellState stateAt(double x, double y) const { return cellState(x2idx(x), y2idx(y)); }
 	/** Number of cells in each state: {unknown, free, occupied}. */
 	std::array<size_t, 3> countStates() const;
-	/** The floor frame in use: the estimate when estimateFloorFromDepth, else T_world_floor. */
+	/** The floor frame in use: the external one when set, the estimate when
+	 * estimateFloorFromDepth, else T_world_floor. */
 	const mrpt::poses::CPose3D& floorPose() const
 	{
-		return insertionOptions.estimateFloorFromDepth ? m_T_world_floorEstimate
-													   : insertionOptions.T_world_floor;
+		return m_floorExternal || insertionOptions.estimateFloorFromDepth ? m_T_world_floorEstimate
+																		  : insertionOptions.T_world_floor;
 	}
 	/** @} */
 
@@ -296,6 +311,8 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	int m_bandSlices{0};  ///< K, the number of height slices m_band was laid out for
 	mrpt::poses::CPose3D m_T_world_floorEstimate;  ///< RANSAC estimate, if m_floorEstimated
 	bool m_floorEstimated{false};
+	/** The floor is set from outside (setExternalFloorPose) into m_T_world_floorEstimate. */
+	bool m_floorExternal{false};
 	std::map<uint64_t, KeyframeRays> m_keyframes;
 	uint64_t m_nextAutoKeyframeId{1ULL << 62};  ///< ids for insertObservation() inputs
 	double m_lastRebuildSeconds{0};

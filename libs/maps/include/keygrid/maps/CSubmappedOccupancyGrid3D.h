@@ -24,6 +24,7 @@
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/ConflictDetector.h>
 #include <keygrid/maps/DepthFrameIntegrator.h>
+#include <keygrid/maps/ExportFrame.h>
 #include <keygrid/maps/GridMorphing.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
 #include <mrpt/config/CLoadableOptions.h>
@@ -184,13 +185,18 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap
 	/** @name Exports
 	 * @{ */
 	/** Writes fusedGrid() as an OctoMap binary tree (.bt, maximum-likelihood occupied / free
-	 * leaves at this resolution). Throws std::runtime_error when the file cannot be written. */
-	void saveAsOctomapBinary(const std::string& path) const;
+	 * leaves at this resolution). Throws std::runtime_error when the file cannot be written.
+	 * In another frame than the world (`frame`, e.g. the floor frame), the grid is resampled
+	 * at the same resolution: each voxel of the output lattice takes the value of the world
+	 * voxel that holds its centre (nearest neighbour); frame.comment becomes a comment line
+	 * of the .bt header, which OctoMap's reader skips. */
+	void saveAsOctomapBinary(const std::string& path, const maps::ExportFrame& frame = {}) const;
 	/** Writes getVisualizationInto() as a SceneViewer3D scene (.3Dscene). Throws
 	 * std::runtime_error when the file cannot be written. */
 	void saveAs3DScene(const std::string& path) const;
-	/** Writes the occupied voxel centres as an ASCII PLY point cloud. */
-	void saveOccupiedAsPly(const std::string& path) const;
+	/** Writes the occupied voxel centres as an ASCII PLY point cloud, mapped into `frame`
+	 * (each centre moved exactly; frame.comment is a PLY comment line). */
+	void saveOccupiedAsPly(const std::string& path, const maps::ExportFrame& frame = {}) const;
 	/** Heap bytes of all submap grids (VoxelBlockGrid::memoryBytes) plus stored depth. */
 	std::size_t memoryBytes() const;
 	/** @} */

@@ -8,9 +8,17 @@
  * keygrid's maps get what they were designed for (the 2D ISM grid a keyframe's map points or
  * depth, the submapped 3D grid the depth with the travelled distance); other maps get the
  * keyframe as a CObservation3DRangeScan at its pose.
+ *
+ * The floor frame: MetricMaps owns the run's one floor estimate (maps::FloorFrameEstimator,
+ * INI section [floor]), fed with every keyframe whether or not a 2D grid is configured. Every
+ * 2D grid takes it as its floor (CISMOccupancyGrid2D::setExternalFloorPose) and is
+ * re-integrated when it changes; map_3d.bt/.ply and hoc_points.ply are written in it. The
+ * maps themselves (and their serialized .bin files) stay in the SLAM world, where loop
+ * closures re-anchor them.
  */
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CHOCPointsMap.h>
+#include <keygrid/maps/FloorFrameEstimator.h>
 #include <keygrid/sfm/SparseMap.h>
 #include <mrpt/maps/CMultiMetricMap.h>
 
@@ -27,11 +35,6 @@ struct MapFeedOptions
 	/** Input of the 2D ISM grid: "sparse" (the keyframe's map points, as in the paper) or
 	 * "dense" (its depth image) (Default: sparse) */
 	std::string ism2dInput{"sparse"};
-	/** 2D grid with estimateFloorFromDepth: the floor plane is re-estimated from samples of the
-	 * depth images (map points where a keyframe has no depth) of all keyframes so far (the
-	 * floor is often out of view at the first one) until it is found and at least this many
-	 * keyframes contributed; the grid is rebuilt when the floor changes (Default: 10) */
-	int floorKeyframes{10};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
@@ -48,18 +51,26 @@ class MetricMaps
 	/** Creates the maps `cfg` asks for. Throws std::invalid_argument naming any `<name>_count`
 	 * key whose map type is unknown (MRPT itself ignores those silently) or when fewer maps
 	 * were created than requested. No [MappingApplication] section: no maps. */
-	MetricMaps(const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed);
+	MetricMaps(
+		const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed,
+		const maps::FloorFrameOptions& floor = {});
 
 	bool empty() const { return m_maps.maps.empty(); }
 	std::size_t size() const { return m_maps.maps.size(); }
 	const mrpt::maps::CMultiMetricMap& maps() const { return m_maps; }
 
-	/** Inserts keyframe `kf` (pose as now in the map) into every map. `travelled` is the
+	/** The run's floor frame (given or estimated; none before the first estimate). */
+	const maps::FloorFrameEstimator& floor() const { return m_floor; }
+	const std::optional<mrpt::poses::CPose3D>& T_world_floor() const { return m_floor.T_world_floor(); }
+
+	/** Inserts keyframe `kf` (pose as now in the map) into every map and its depth samples
+	 * (its map points when it has no depth) into the floor estimate. `travelled` is the
 	 * camera's path length so far [m]. */
 	void insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId kf, double travelled);
 
-	/** Re-anchors the maps on corrected keyframe poses (kf id -> new T_world_cam): the 2D
-	 * grid is rebuilt from its stored keyframe observations, the 3D grid morphed and merged.
+	/** Re-anchors the maps on corrected keyframe poses (kf id -> new T_world_cam): the floor
+	 * is re-estimated under them, the 2D grid is rebuilt from its stored keyframe
+	 * observations, the 3D grid morphed and merged.
 	 * Returns seconds spent per map name. */
 	std::map<std::string, double> applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses);
 
@@ -73,7 +84,9 @@ class MetricMaps
 
 	/** Writes each map's outputs into dir (map_2d.{pgm,yaml,png}, map_3d.bt, map_3d.ply,
 	 * hoc_points.ply, and each keygrid map serialized, gz-compressed: map_2d.bin, map_3d.bin,
-	 * hoc_points.bin, readable with CFileGZInputStream + archiveFrom >> map); each file appears
+	 * hoc_points.bin, readable with CFileGZInputStream + archiveFrom >> map); map_3d.* and
+	 * hoc_points.ply are in the floor frame when there is one (their comment line records
+	 * T_world_floor), the .bin files in the SLAM world; each file appears
 	 * atomically (written in DIR/.maps.tmp, then renamed);
 	 * returns the file names written. */
 	std::vector<std::string> writeOutputs(const std::string& dir) const;
@@ -86,12 +99,14 @@ class MetricMaps
 	mrpt::maps::CMultiMetricMap m_maps;
 	MapFeedOptions m_feed;
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> m_insertedPoses;
-	/** Floor estimate of the 2D grid: samples of the first keyframes (world frame), how
-	 * many keyframes they came from, and the first keyframe's pose (origin and heading of the floor frame). */
-	std::vector<mrpt::math::TPoint3D> m_floorPoints;
-	int m_floorKeyframes{0};
-	mrpt::math::TVector3D m_floorUpSum{0, 0, 0};  //!< sum of those keyframes' -y axes
-	std::optional<mrpt::poses::CPose3D> m_firstKeyframePose;
+	maps::FloorFrameEstimator m_floor;
+	/** Dense 2D input, per map index: keyframes that arrived before the floor was known. */
+	std::map<std::size_t, std::vector<sfm::KeyFrameId>> m_pendingDense;
+
+	/** Hands a new floor frame to every 2D grid and re-integrates those that hold keyframes. */
+	void floorChanged();
+	/** The frame map outputs are written in: the floor frame, else the SLAM world. */
+	maps::ExportFrame outputFrame() const;
 };
 
 }  // namespace keygrid::slam

@@ -4,10 +4,12 @@
  * (`SceneViewer3D -l libkeygrid_maps.so scene.3Dscene`).
  *
  * Named objects (COpenGLViewport::getByName finds them):
- *  - "ground": CGridPlaneXY, 1 m cells, at display z = 0 (the floor when the run has a 2D grid);
+ *  - "ground": CGridPlaneXY, 1 m cells, at display z = 0 (the floor when the run has a floor
+ *    frame);
  *  - "keygrid_run": CSetOfObjects holding the next three, posed so that "up" is +Z on screen:
- *    the inverse of the 2D grid's floor pose when the run has a CISMOccupancyGrid2D, else
- *    core::T_depth_cam() (the first camera's optical axes shown as MRPT's x forward, z up);
+ *    inverse(T_world_floor) when the run has a floor frame (the display frame is then the
+ *    floor frame of every other output), else core::T_depth_cam() (the first camera's
+ *    optical axes shown as MRPT's x forward, z up);
  *  - "trajectory": CSetOfLines, a line strip through the camera centres of every frame
  *    (trajectory.txt), i.e. N poses -> N-1 consecutive segments (1 pose -> 1 null segment);
  *  - "keyframes": CSetOfObjects with one CFrustum per keyframe at its final pose;
@@ -20,6 +22,7 @@
 #include <mrpt/maps/CMultiMetricMap.h>
 #include <mrpt/opengl/COpenGLScene.h>
 
+#include <optional>
 #include <string>
 
 namespace keygrid::slam
@@ -36,15 +39,17 @@ struct SceneExportOptions
 };
 
 /** Builds the scene of a run: `trajectory` (every frame, T_world_cam), the keyframes and
- * landmarks of `map`, and every map of `maps` (may be null). */
+ * landmarks of `map`, and every map of `maps` (may be null), shown in the floor frame
+ * `T_world_floor` when given. */
 mrpt::opengl::COpenGLScene::Ptr buildRunScene(
 	const core::Trajectory& trajectory, const sfm::SparseMap& map,
-	const mrpt::maps::CMultiMetricMap* maps, const SceneExportOptions& opts = {});
+	const mrpt::maps::CMultiMetricMap* maps, const std::optional<mrpt::poses::CPose3D>& T_world_floor,
+	const SceneExportOptions& opts = {});
 
 /** buildRunScene() saved gz-compressed to `path` atomically (temp file + rename). */
 void writeRunScene(
 	const core::Trajectory& trajectory, const sfm::SparseMap& map,
-	const mrpt::maps::CMultiMetricMap* maps, const std::string& path,
-	const SceneExportOptions& opts = {});
+	const mrpt::maps::CMultiMetricMap* maps, const std::optional<mrpt::poses::CPose3D>& T_world_floor,
+	const std::string& path, const SceneExportOptions& opts = {});
 
 }  // namespace keygrid::slam

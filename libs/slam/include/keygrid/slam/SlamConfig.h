@@ -4,7 +4,8 @@
  *
  * Sections: [slam] (mode, camera), [features], [tracker], [mapping] (local mapping and local
  * bundle adjustment), [refinement] (final global bundle adjustment and frame re-estimation),
- * [loop_closing] (place recognition and pose graph), [maps] (how keyframes feed the maps) and [MappingApplication] (the maps themselves, MRPT's
+ * [loop_closing] (place recognition and pose graph), [maps] (how keyframes feed the maps), [floor]
+ * (the floor frame every map output is written in) and [MappingApplication] (the maps themselves, MRPT's
  * CMultiMetricMap format, see MetricMaps). Keys absent from the file keep their documented defaults.
  */
 #include <keygrid/sfm/FeatureExtractor.h>
@@ -60,6 +61,7 @@ struct SlamConfig
 	sfm::LocalMapperOptions mapping;
 	RefinementOptions refinement;
 	MapFeedOptions maps;
+	maps::FloorFrameOptions floor;
 	LoopClosingOptions loop;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);

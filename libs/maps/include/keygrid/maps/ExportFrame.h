@@ -1,0 +1,34 @@
+#pragma once
+/** \file ExportFrame.h
+ * The frame a map file is written in (keygrid-slam: the run's floor frame), and the line of
+ * metadata that records it in the file (a PLY `comment`, a comment line of an OctoMap .bt
+ * header).
+ */
+#include <mrpt/poses/CPose3D.h>
+
+#include <string>
+
+namespace keygrid::maps
+{
+struct ExportFrame
+{
+	/** Points are written as T_out_world * p_world (Default: identity, the map's own frame) */
+	mrpt::poses::CPose3D T_out_world;
+	/** Metadata line without its comment marker, e.g. "keygrid T_world_floor (x y z qx qy qz
+	 * qw): ..."; empty = none (Default: empty) */
+	std::string comment;
+
+	bool isIdentity() const
+	{
+		return T_out_world.translation().norm() == 0 && T_out_world.getRotationMatrix() == mrpt::math::CMatrixDouble33::Identity();
+	}
+};
+
+/** "keygrid T_world_floor (x y z qx qy qz qw): x y z qx qy qz qw" (%.9g), the metadata line
+ * of every map output in the floor frame (the same as map_2d.yaml's first-line comment). */
+std::string floorFrameComment(const mrpt::poses::CPose3D& T_world_floor);
+
+/** The floor frame as an ExportFrame: T_out_world = inverse(T_world_floor), with its comment. */
+ExportFrame floorExportFrame(const mrpt::poses::CPose3D& T_world_floor);
+
+}  // namespace keygrid::maps
