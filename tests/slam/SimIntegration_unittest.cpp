@@ -42,7 +42,7 @@ TEST(SimIntegration, ShippedSimConfigTracksAGeneratedSequenceWithMaps)
 			freeCells += p > 0.65f;
 		}
 	EXPECT_GT(occupied, 50);
-	// Free only where the floor was seen (height-band free space): 464 cells on 2026-11-26.
+	// Free space only where the floor was seen (height-band free space).
 	EXPECT_GT(freeCells, 300);
 	EXPECT_GT(mrpt::system::getFileSize(o.output + "/map_3d.bt"), 1000u);
 	// The serialized maps load back as their classes; the HOC map holds as many points as the
