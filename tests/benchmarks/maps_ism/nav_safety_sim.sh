@@ -112,7 +112,9 @@ for scene in $scenes; do
       rm -rf "$run"; mkdir -p "$run"
       extra=(); [ "$maxFrames" -gt 0 ] && extra=(--max-frames "$maxFrames")
       echo "== $scene, $model, $input: keygrid-slam -> $run" >&2
-      if ! "$bin/keygrid-slam" --quiet --config "$root/config/sim.ini" --input "$sim/sequence.rawlog" \
+      # Scenes with [output] write_rawlog = false (office_loop) have only the TUM folder.
+      input_path="$sim/sequence.rawlog"; [ -f "$input_path" ] || input_path="$sim/tum"
+      if ! "$bin/keygrid-slam" --quiet --config "$root/config/sim.ini" --input "$input_path" \
           --output "$run" --gt "$sim/groundtruth.txt" --set "$overrides" "${extra[@]}" >"$run/slam.log" 2>&1; then
         row "$scene" "$model" "$input" "slam failed" "" "" "" "$run/slam.log" "" "" >> "$table"; continue
       fi
