@@ -39,7 +39,8 @@ print(f"  loop closures: {len(r.get('loop_closures', []))}")
 for m in r.get('maps', []): print("  map", m)
 print(f"  2D map vs the floor plan: hazard cells {e['map_hazard_cells']} (obstacle cells called free, "
       f"of {e['map_interior_obstacle_cells']} interior), obstacle recall {e['map_boundary_recall']:.3f} "
-      f"(boundary cells seen), precision {e['map_obstacle_precision']:.3f}, free-space F1 {e['map_free_f1']:.3f}; "
+      f"(boundary cells seen), precision {e['map_obstacle_precision']:.3f}, free-space F1 "
+      f"{e['map_free_f1_floor_seen']:.3f} where the floor was in view ({e['map_free_f1']:.3f} where any ray passed); "
       f"floor {100*e['map_floor_offset_m']:+.1f} cm / {e['map_floor_tilt_deg']:.2f} deg off")
 print(f"  overlay: {sys.argv[4]}  (black occupied, white free, orange missed, red HAZARD, blue false obstacle)")
 PY
