@@ -55,4 +55,16 @@ Similarity3 alignPointSets(
 	return out;
 }
 
+mrpt::poses::CPose3D rigidPose(const Similarity3& a)
+{
+	mrpt::math::CMatrixDouble44 H;
+	H.setIdentity();
+	for (int r = 0; r < 3; r++)
+	{
+		for (int c = 0; c < 3; c++) H(r, c) = a.R(r, c);
+		H(r, 3) = a.t(r);
+	}
+	return mrpt::poses::CPose3D(H);
+}
+
 }  // namespace keygrid::eval

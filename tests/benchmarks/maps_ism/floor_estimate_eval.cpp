@@ -62,15 +62,7 @@ mrpt::poses::CPose3D umeyama(const core::Trajectory& gt, const core::Trajectory&
 	gtCentroid.setZero();
 	for (const auto& p : y) gtCentroid += p;
 	gtCentroid /= static_cast<double>(y.size());
-	const auto s = eval::alignPointSets(x, y, false);
-	mrpt::math::CMatrixDouble44 H;
-	H.setIdentity();
-	for (int r = 0; r < 3; r++)
-	{
-		for (int c = 0; c < 3; c++) H(r, c) = s.R(r, c);
-		H(r, 3) = s.t(r);
-	}
-	return mrpt::poses::CPose3D(H);
+	return eval::rigidPose(eval::alignPointSets(x, y, false));
 }
 
 struct Estimate

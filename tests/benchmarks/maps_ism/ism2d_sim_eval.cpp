@@ -128,15 +128,7 @@ mrpt::poses::CPose3D alignTrajectory(const core::Trajectory& gt, const core::Tra
 	}
 	if (!firstGt) throw std::runtime_error("no common timestamps between the trajectories");
 	if (how == "first") return *firstGt + (-*firstEst);
-	const auto s = eval::alignPointSets(x, y, false);
-	mrpt::math::CMatrixDouble44 H;
-	H.setIdentity();
-	for (int r = 0; r < 3; r++)
-	{
-		for (int c = 0; c < 3; c++) H(r, c) = s.R(r, c);
-		H(r, 3) = s.t(r);
-	}
-	return mrpt::poses::CPose3D(H);
+	return eval::rigidPose(eval::alignPointSets(x, y, false));
 }
 
 void printMetrics(const std::string& label, const maps::OccupancyMetrics& m, const maps::OccupancyMetrics& strict)

@@ -12,19 +12,6 @@ namespace keygrid::slam
 {
 namespace
 {
-/** The SE(3) part of the trajectory alignment as a pose: T_gt_est. */
-mrpt::poses::CPose3D toPose(const eval::Similarity3& a)
-{
-	mrpt::math::CMatrixDouble44 H;
-	H.setIdentity();
-	for (int r = 0; r < 3; r++)
-	{
-		for (int c = 0; c < 3; c++) H(r, c) = a.R(r, c);
-		H(r, 3) = a.t(r);
-	}
-	return mrpt::poses::CPose3D(H);
-}
-
 /** The trajectory JSON object with the map's fields appended. */
 std::string mergeJson(const std::string& trajectoryJson, const std::string& mapFields)
 {
@@ -104,7 +91,7 @@ int EvalApp::run(int argc, const char* const* argv)
 		std::string json = res.toJson();
 		if (mapMode)
 		{
-			const auto m = evaluateMapAgainstFloorPlan(mo, toPose(res.alignment), gt);
+			const auto m = evaluateMapAgainstFloorPlan(mo, eval::rigidPose(res.alignment), gt);
 			std::cout << m.toText();
 			if (!mo.overlayPath.empty()) std::cout << "overlay: " << mo.overlayPath << "\n";
 			json = mergeJson(json, m.jsonFields());

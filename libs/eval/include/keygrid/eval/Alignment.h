@@ -3,6 +3,7 @@
  * Closed-form least-squares alignment of two point sets (Horn 1987 / Umeyama 1991).
  */
 #include <Eigen/Core>
+#include <mrpt/poses/CPose3D.h>
 
 #include <vector>
 
@@ -28,5 +29,8 @@ struct Similarity3
  * coincident points R = I. */
 Similarity3 alignPointSets(
 	const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y, bool withScale);
+
+/** The rotation and translation of an alignment as a pose (the scale dropped): T_y_x. */
+mrpt::poses::CPose3D rigidPose(const Similarity3& a);
 
 }  // namespace keygrid::eval

@@ -140,8 +140,8 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 		double bandSliceHeight{0.05};
 		/** Ray traversal: "bresenham" or "antialiased" (Default: bresenham) */
 		RayTraversal rayTraversal{RayTraversal::Bresenham};
-		/** Dense depth: use every n-th pixel in rows and columns. At 2 a 640x480 Kinect image
-		 * still samples a 5 cm cell with 3 pixel rows and columns at maxRange (Default: 2) */
+		/** Dense depth: use every n-th pixel in rows and columns; 2 keeps several pixels per
+		 * 5 cm cell of a 640x480 Kinect image out to maxRange (Default: 2) */
 		int depthDecimation{2};
 		/** Dense depth: minimum points in an endpoint cell before it casts an obstacle ray,
 		 * rejects speckle (Default: 2) */
