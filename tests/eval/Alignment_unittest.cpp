@@ -89,3 +89,34 @@ TEST(Alignment, RejectsTooFewAndHandlesDegeneratePoints)
 	EXPECT_NEAR((b.R - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-15);
 	EXPECT_NEAR((b.apply(same[0]) - other[0]).norm(), 0.0, 1e-15);
 }
+
+TEST(Alignment, PosesFixTheRotationWhereTheCameraOnlyTurns)
+{
+	// A camera turning on the spot: its positions all lie within 2 mm, measured with 1 mm
+	// noise, so a position fit cannot see the rotation between the frames; the orientations
+	// give it exactly.
+	const mrpt::poses::CPose3D T_y_x(0.4, -1.2, 0.3, 0.7, -0.2, 0.1);
+	std::mt19937 g(5);
+	std::uniform_real_distribution<double> noise(-0.001, 0.001);
+	std::vector<mrpt::poses::CPose3D> x, y;
+	std::vector<Eigen::Vector3d> px, py;
+	for (int k = 0; k < 40; k++)
+	{
+		const mrpt::poses::CPose3D p(0.001 * std::sin(k), 0.001 * std::cos(k), 0.0, 0.1 * k, 0.05 * std::sin(0.3 * k), 0.02 * k);
+		x.push_back(p);
+		y.push_back(T_y_x + p);
+		y.back().x_incr(noise(g));
+		y.back().y_incr(noise(g));
+		y.back().z_incr(noise(g));
+		px.emplace_back(x.back().x(), x.back().y(), x.back().z());
+		py.emplace_back(y.back().x(), y.back().y(), y.back().z());
+	}
+	const auto a = keygrid::eval::alignPoses(x, y);
+	const Eigen::Matrix3d R = T_y_x.getRotationMatrix().asEigen();
+	EXPECT_LT((a.R - R).norm(), 1e-9);
+	EXPECT_LT((a.t - Eigen::Vector3d(T_y_x.x(), T_y_x.y(), T_y_x.z())).norm(), 1e-3) << "the mean of the noise";
+	EXPECT_DOUBLE_EQ(a.s, 1.0);
+	// The position fit of the same data is far off (the reason for alignPoses).
+	EXPECT_GT((alignPointSets(px, py, false).R - R).norm(), 0.03) << "over a degree";
+	EXPECT_THROW(keygrid::eval::alignPoses({}, {}), std::invalid_argument);
+}

@@ -143,3 +143,30 @@ TEST(TrajectoryErrors, OrientationErrorIsTheKnownPerturbationAngleAlsoForAStatic
 		EXPECT_NEAR(r.ateRotDeg.max, 0.5, tol);
 	}
 }
+
+TEST(TrajectoryErrors, AFixedAlignmentMeasuresInTheGivenFrameWithoutRefitting)
+{
+	// Two runs in one world: the first run's alignment (here exact) puts the second run's
+	// estimate into the ground-truth frame. An estimate offset by 3 cm along x in that frame
+	// has ATE 3 cm with the fixed alignment; a fitted one would absorb the offset.
+	const auto gt = makeGroundTruth(300);
+	const CPose3D T_est_world(0.5, 0.2, -0.1, 0.3, 0.1, -0.2);
+	core::Trajectory est;
+	for (const auto& p : gt)
+	{
+		CPose3D shifted = p.T_world_cam;
+		shifted.x_incr(0.03);
+		est.push_back({p.t, T_est_world + shifted});
+	}
+	eval::TrajectoryErrorOptions o;
+	CPose3D T_world_est = T_est_world;
+	T_world_est.inverse();
+	eval::Similarity3 a;
+	a.R = T_world_est.getRotationMatrix().asEigen();
+	a.t = Eigen::Vector3d(T_world_est.x(), T_world_est.y(), T_world_est.z());
+	o.fixedAlignment = a;
+	const auto fixed = eval::evaluateTrajectory(gt, est, o);
+	EXPECT_NEAR(fixed.ate.rmse, 0.03, 1e-9);
+	EXPECT_NEAR(fixed.ateRotDeg.rmse, 0.0, 1e-5);
+	EXPECT_NEAR(eval::evaluateTrajectory(gt, est).ate.rmse, 0.0, 1e-9);
+}

@@ -88,7 +88,8 @@ TEST(KeyFrameImageCodec, OptionsValidateAndLoad)
 	mrpt::config::CConfigFileMemory out;
 	p.saveToConfigFile(out, "store");
 	ImageCodecOptions q;
-	q.loadFromConfigFile(out, "store");
+	// Through the text, as a saved file is read (comments are stripped when text is parsed).
+	q.loadFromConfigFile(mrpt::config::CConfigFileMemory(out.getContent()), "store");
 	EXPECT_EQ(q.colourFormat, "jpg");
 	EXPECT_EQ(q.jpegQuality, 80);
 	EXPECT_EQ(q.pngCompression, 1);

@@ -205,21 +205,37 @@ TEST(SessionStore, UpsertsPosesAndErasures)
 		changed.hocCounts.assign(60, 3);
 		v.landmarks.push_back(changed);
 		v.poses.push_back({1, mrpt::poses::CPose3D(1, 2, 3, 0.1, 0.2, 0.3)});
+		KeyFrameLandmarks assoc{0, std::vector<LandmarkId>(50, kNoLandmark)};
+		assoc.landmarks[7] = 1;
+		v.associations.push_back(assoc);
 		v.erasedKeyFrames.push_back(2);
 		v.erasedLandmarks.push_back(2);
 		v.covisibility.push_back({1, 0, 0});  // weight 0 removes the edge
 		v.snapshots.push_back({"map_2d", 2, {4, 5}});
+		v.attributes["run.tracking_share_median"] = "0.25";
 		store.write(v);
+		EXPECT_EQ(store.meta().attributes.at("run.tracking_share_median"), "0.25");
+		SessionUpdate badKey;
+		badKey.attributes["camera_fx"] = "1";
+		EXPECT_THROW(store.write(badKey), std::invalid_argument) << "only run.* keys: the store's own meta rows are not attributes";
 
 		SessionUpdate bad;
 		bad.poses.push_back({9, mrpt::poses::CPose3D()});
 		bad.landmarks.push_back(test::syntheticLandmark(5, 0, 1));
 		EXPECT_THROW(store.write(bad), std::invalid_argument);
+		SessionUpdate wrongLength;
+		wrongLength.associations.push_back({0, std::vector<LandmarkId>(49, kNoLandmark)});
+		EXPECT_THROW(store.write(wrongLength), std::invalid_argument) << "one entry per keypoint";
 	}
 	auto store = SessionStore::Open(path);
+	EXPECT_EQ(store.meta().attributes, (std::map<std::string, std::string>{{"run.tracking_share_median", "0.25"}}));
+	EXPECT_DOUBLE_EQ(store.meta().camera.fx, testMeta().camera.fx) << "a refused attribute changes nothing";
 	const auto kfs = store.loadKeyFrames();
 	ASSERT_EQ(kfs.size(), 2u);
 	test::expectSamePose(kfs[1].T_world_cam, mrpt::poses::CPose3D(1, 2, 3, 0.1, 0.2, 0.3));
+	std::vector<LandmarkId> expected(50, kNoLandmark);
+	expected[7] = 1;
+	EXPECT_EQ(kfs[0].landmarks, expected);
 	EXPECT_TRUE(store.loadEncodedImages(2).empty());
 	EXPECT_FALSE(store.loadEncodedImages(1).empty());
 	const auto lms = store.loadLandmarks();
@@ -253,6 +269,8 @@ TEST(SessionStore, ReopenToExtendAndReadOnlyRefusesWrites)
 		store.setVocabulary({"other.bin", "fedcba9876543210", 1000});
 	}
 	auto store = SessionStore::Open(path);
+	EXPECT_EQ(store.meta().attributes, (std::map<std::string, std::string>{{"run.tracking_share_median", "0.25"}}));
+	EXPECT_DOUBLE_EQ(store.meta().camera.fx, testMeta().camera.fx) << "a refused attribute changes nothing";
 	const auto kfs = store.loadKeyFrames();
 	ASSERT_EQ(kfs.size(), 2u);
 	test::expectSameCamera(kfs[0].camera, core::RgbdCamera::Preset("fr1"));
@@ -360,8 +378,10 @@ TEST(SessionStoreOptions, IniRoundTripAndErrorsNameTheKey)
 	o.cacheSizeKiB = 4096;
 	o.busyTimeoutMs = 100;
 	o.integrityCheck = "none";
-	mrpt::config::CConfigFileMemory ini;
-	o.saveToConfigFile(ini, "store");
+	mrpt::config::CConfigFileMemory saved;
+	o.saveToConfigFile(saved, "store");
+	// Through the text, as a saved file is read (comments are stripped when text is parsed).
+	mrpt::config::CConfigFileMemory ini(saved.getContent());
 	SessionStoreOptions back;
 	back.loadFromConfigFile(ini, "store");
 	EXPECT_EQ(back.durability, "normal");

@@ -55,6 +55,37 @@ Similarity3 alignPointSets(
 	return out;
 }
 
+Eigen::Matrix3d chordalMeanRotation(const std::vector<Eigen::Matrix3d>& Rx, const std::vector<Eigen::Matrix3d>& Ry)
+{
+	if (Rx.size() != Ry.size() || Rx.empty())
+		throw std::invalid_argument("chordalMeanRotation: " + std::to_string(Rx.size()) + " vs " + std::to_string(Ry.size()) + " rotations");
+	Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
+	for (std::size_t k = 0; k < Rx.size(); k++) M += Ry[k] * Rx[k].transpose();
+	Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
+	Eigen::Matrix3d W = Eigen::Matrix3d::Identity();
+	if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) W(2, 2) = -1;
+	return svd.matrixU() * W * svd.matrixV().transpose();
+}
+
+Similarity3 alignPoses(const std::vector<mrpt::poses::CPose3D>& x, const std::vector<mrpt::poses::CPose3D>& y)
+{
+	if (x.size() != y.size() || x.empty())
+		throw std::invalid_argument("alignPoses: " + std::to_string(x.size()) + " vs " + std::to_string(y.size()) + " poses");
+	std::vector<Eigen::Matrix3d> Rx, Ry;
+	for (std::size_t k = 0; k < x.size(); k++)
+	{
+		Rx.push_back(x[k].getRotationMatrix().asEigen());
+		Ry.push_back(y[k].getRotationMatrix().asEigen());
+	}
+	Similarity3 out;
+	out.R = chordalMeanRotation(Rx, Ry);
+	Eigen::Vector3d t = Eigen::Vector3d::Zero();
+	for (std::size_t k = 0; k < x.size(); k++)
+		t += Eigen::Vector3d(y[k].x(), y[k].y(), y[k].z()) - out.R * Eigen::Vector3d(x[k].x(), x[k].y(), x[k].z());
+	out.t = t / static_cast<double>(x.size());
+	return out;
+}
+
 mrpt::poses::CPose3D rigidPose(const Similarity3& a)
 {
 	mrpt::math::CMatrixDouble44 H;

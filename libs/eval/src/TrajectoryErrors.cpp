@@ -45,6 +45,23 @@ ErrorStats ErrorStats::Of(std::vector<double> v)
 	return s;
 }
 
+Similarity3 alignTrajectoryPoses(const core::Trajectory& gt, const core::Trajectory& est, double maxDt)
+{
+	std::vector<double> te, tg;
+	for (const auto& p : est) te.push_back(p.t);
+	for (const auto& p : gt) tg.push_back(p.t);
+	std::vector<mrpt::poses::CPose3D> x, y;
+	for (const auto& [i, j] : core::associateTimestamps(te, tg, maxDt))
+	{
+		x.push_back(est[i].T_world_cam);
+		y.push_back(gt[j].T_world_cam);
+	}
+	if (x.size() < 3)
+		throw std::invalid_argument("alignTrajectoryPoses: only " + std::to_string(x.size()) + " estimated poses have a ground-truth pose within " +
+									std::to_string(maxDt) + " s (need >= 3)");
+	return alignPoses(x, y);
+}
+
 TrajectoryErrors evaluateTrajectory(
 	const core::Trajectory& gt, const core::Trajectory& est, const TrajectoryErrorOptions& opts)
 {
@@ -74,31 +91,25 @@ TrajectoryErrors evaluateTrajectory(
 		x.emplace_back(pe.x(), pe.y(), pe.z());
 		y.emplace_back(pg.x(), pg.y(), pg.z());
 	}
-	out.alignment = alignPointSets(x, y, opts.withScale);
+	out.alignment = opts.fixedAlignment ? *opts.fixedAlignment : alignPointSets(x, y, opts.withScale);
 	std::vector<double> ate;
 	for (std::size_t k = 0; k < x.size(); k++) ate.push_back((out.alignment.apply(x[k]) - y[k]).norm());
 	out.ate = ErrorStats::Of(ate);
 
-	// --- Orientation: R_a = argmin sum_k |R_gt_k - R_a R_est_k|_F^2 = polar(sum_k R_gt_k R_est_k^T)
-	// (U V^T of its SVD, det fixed to +1), then the angle of each residual rotation.
+	// --- Orientation: R_a = argmin sum_k |R_gt_k - R_a R_est_k|_F^2 (chordalMeanRotation), then
+	// the angle of each residual rotation.
 	{
-		Eigen::Matrix3d M = Eigen::Matrix3d::Zero();
-		std::vector<std::pair<Eigen::Matrix3d, Eigen::Matrix3d>> rots;
+		std::vector<Eigen::Matrix3d> Rest, Rgt;
 		for (const auto& [i, j] : matches)
 		{
-			const Eigen::Matrix3d Re = est[i].T_world_cam.getRotationMatrix().asEigen();
-			const Eigen::Matrix3d Rg = gt[j].T_world_cam.getRotationMatrix().asEigen();
-			M += Rg * Re.transpose();
-			rots.emplace_back(Rg, Re);
+			Rest.push_back(est[i].T_world_cam.getRotationMatrix().asEigen());
+			Rgt.push_back(gt[j].T_world_cam.getRotationMatrix().asEigen());
 		}
-		Eigen::JacobiSVD<Eigen::Matrix3d> svd(M, Eigen::ComputeFullU | Eigen::ComputeFullV);
-		Eigen::Matrix3d W = Eigen::Matrix3d::Identity();
-		if ((svd.matrixU() * svd.matrixV().transpose()).determinant() < 0) W(2, 2) = -1;
-		const Eigen::Matrix3d Ra = svd.matrixU() * W * svd.matrixV().transpose();
+		const Eigen::Matrix3d Ra = opts.fixedAlignment ? opts.fixedAlignment->R : chordalMeanRotation(Rest, Rgt);
 		std::vector<double> angles;
-		for (const auto& [Rg, Re] : rots)
+		for (std::size_t k = 0; k < Rest.size(); k++)
 		{
-			const Eigen::Matrix3d E = Rg.transpose() * Ra * Re;
+			const Eigen::Matrix3d E = Rgt[k].transpose() * Ra * Rest[k];
 			angles.push_back(mrpt::RAD2DEG(std::acos(std::clamp((E.trace() - 1.0) / 2.0, -1.0, 1.0))));
 		}
 		out.ateRotDeg = ErrorStats::Of(angles);

@@ -31,6 +31,32 @@ KeyFrame& SparseMap::addKeyFrame(KeyFrame kf)
 	return m_keyframes.emplace(kf.id, std::move(kf)).first->second;
 }
 
+KeyFrame& SparseMap::restoreKeyFrame(KeyFrame kf)
+{
+	if (m_keyframes.count(kf.id)) throw std::invalid_argument("SparseMap::restoreKeyFrame: keyframe " + std::to_string(kf.id) + " is in the map already");
+	kf.landmarks.assign(kf.features.size(), kNoLandmark);
+	kf.covisibility.clear();
+	m_nextKf = std::max(m_nextKf, kf.id + 1);
+	const KeyFrameId id = kf.id;
+	return m_keyframes.emplace(id, std::move(kf)).first->second;
+}
+
+void SparseMap::restoreLandmark(Landmark lm)
+{
+	if (m_landmarks.count(lm.id)) throw std::invalid_argument("SparseMap::restoreLandmark: landmark " + std::to_string(lm.id) + " is in the map already");
+	for (const auto& [kfId, kp] : lm.observations)
+	{
+		const auto it = m_keyframes.find(kfId);
+		if (it == m_keyframes.end() || kp < 0 || static_cast<std::size_t>(kp) >= it->second.landmarks.size())
+			throw std::invalid_argument("SparseMap::restoreLandmark: landmark " + std::to_string(lm.id) + " is observed by keypoint " +
+										std::to_string(kp) + " of keyframe " + std::to_string(kfId) + ", which the map does not hold");
+	}
+	for (const auto& [kfId, kp] : lm.observations) m_keyframes.at(kfId).landmarks[static_cast<std::size_t>(kp)] = lm.id;
+	m_nextLm = std::max(m_nextLm, lm.id + 1);
+	const LandmarkId id = lm.id;
+	m_landmarks.emplace(id, std::move(lm));
+}
+
 LandmarkId SparseMap::addLandmark(const Eigen::Vector3d& p, KeyFrameId kf, int kp)
 {
 	Landmark lm;

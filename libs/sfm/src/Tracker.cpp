@@ -138,7 +138,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 			out.observations.push_back(ob);
 		}
 		if (m_hoc) updateHoc(cur, out);
-		if (needKeyFrame(cur))
+		if (m_insertKeyFrames && needKeyFrame(cur))
 		{
 			out.keyframe = createKeyFrame(cur);
 			out.newKeyFrame = true;
@@ -164,6 +164,15 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 	else
 		m_lastRelative.reset();
 	return out;
+}
+
+std::optional<double> Tracker::recentShareMedian() const
+{
+	if (m_recentShares.empty()) return std::nullopt;
+	std::vector<double> v(m_recentShares.begin(), m_recentShares.end());
+	auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+	std::nth_element(v.begin(), mid, v.end());
+	return *mid;
 }
 
 double Tracker::stepDuration(double timestamp) const

@@ -97,6 +97,7 @@ LoopCloser::LoopCloser(
 std::string LoopCloser::vocabularySource() const
 {
 	if (!m_vocabFile.empty()) return m_vocabFile;
+	if (!m_vocabSource.empty()) return m_vocabSource;
 	if (m_vocab.empty()) return "not trained yet (needs " + std::to_string(m_opts.trainKeyFrames) + " keyframes)";
 	return "trained in the run on " + std::to_string(m_vocab.trainingImages()) + " keyframes";
 }
@@ -112,6 +113,26 @@ void LoopCloser::trainIfReady()
 		m_db.add(id, m_vocab.transform(kf.features.descriptors));
 		m_dbIds.insert(id);
 	}
+}
+
+void LoopCloser::useVocabulary(loop::Vocabulary vocabulary, const std::string& source)
+{
+	m_vocab = std::move(vocabulary);
+	m_vocabFile.clear();
+	m_vocabSource = source;
+	m_db.clear();
+	m_dbIds.clear();
+}
+
+void LoopCloser::indexKeyFrames()
+{
+	if (m_vocab.empty()) return;
+	for (const auto& [id, kf] : m_map.keyframes())
+		if (!m_db.contains(id))
+		{
+			m_db.add(id, m_vocab.transform(kf.features.descriptors));
+			m_dbIds.insert(id);
+		}
 }
 
 std::vector<sfm::KeyFrameId> LoopCloser::placeCandidates(const cv::Mat& descriptors, int maxCandidates) const
@@ -247,6 +268,7 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 	LoopClosureEvent ev;
 	ev.keyframe = cur;
 	ev.loopKeyFrame = cand;
+	ev.T_loop_cur = toCPose3D(T_cand_cur);
 	if (!summary.usable) return ev;
 	std::map<sfm::KeyFrameId, Eigen::Isometry3d> oldIso, newIso;
 	for (const auto& c : summary.corrections)

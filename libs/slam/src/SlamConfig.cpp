@@ -32,6 +32,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	maps.loadFromConfigFile(c, "maps");
 	floor.loadFromConfigFile(c, "floor");
 	loop.loadFromConfigFile(c, "loop_closing");
+	store.loadFromConfigFile(c, "store");
 	// The depth residual model is shared by tracking and bundle adjustment.
 	mapping.ba.bf = tracker.pose.bf;
 	mapping.ba.disparitySigma = tracker.pose.disparitySigma;
@@ -52,6 +53,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	maps.saveToConfigFile(c, "maps");
 	floor.saveToConfigFile(c, "floor");
 	loop.saveToConfigFile(c, "loop_closing");
+	store.saveToConfigFile(c, "store");
 	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame that is not a keyframe against the final map");
 }
 

@@ -1,6 +1,7 @@
 #include <keygrid/slam/System.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <future>
 #include <stdexcept>
 
@@ -46,6 +47,36 @@ System::System(const SlamConfig& cfg)
 }
 
 System::~System() { joinThreads(); }
+
+void System::noteRunAttributes()
+{
+	if (const auto share = m_tracker.recentShareMedian())
+		m_recorder->setAttribute(kTrackingShareAttribute, std::to_string(*share));
+}
+
+LoadedSession System::loadSession(const store::SessionStore& session, bool localizeOnly)
+{
+	if (!m_frames.empty()) throw std::logic_error("System::loadSession: a session is loaded before the first frame");
+	std::lock_guard<std::mutex> lock(m_map.mutex());
+	const auto loaded = loadSparseMap(session, m_map);
+	m_localizeOnly = localizeOnly;
+	m_tracker.startInLoadedMap();
+	m_tracker.setKeyFrameInsertion(!localizeOnly);
+	// The first relocalization is judged against the share the mapping run's tracking matched.
+	if (const auto it = session.meta().attributes.find(kTrackingShareAttribute); it != session.meta().attributes.end())
+	{
+		const double share = std::strtod(it->second.c_str(), nullptr);
+		if (share > 0 && share <= 1) m_tracker.seedRecentShare(share);
+	}
+	if (m_loopCloser)
+	{
+		// A vocabulary trained in the mapping run exists only in the file.
+		if (m_loopCloser->vocabularyFile().empty() && session.hasStoredVocabulary())
+			m_loopCloser->useVocabulary(*session.loadVocabulary(), "stored in " + session.path());
+		m_loopCloser->indexKeyFrames();
+	}
+	return loaded;
+}
 
 sfm::FrameFeatures System::extract(const core::Frame& frame) const { return m_extractor.extract(frame); }
 
@@ -142,11 +173,26 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 		m_timings.add("map_insertion", secondsSince(t0));
 	}
-	if (!m_loopCloser) return;
+	const auto ev = closeLoops(job, tf);
+	if (m_recorder)
+	{
+		const auto t0 = std::chrono::steady_clock::now();
+		noteRunAttributes();
+		m_recorder->afterKeyFrame(m_map, m_loopCloser.get(), ev ? &*ev : nullptr, m_maps.get());
+		m_timings.add("session_store", secondsSince(t0));
+	}
+	if (!ev) return;
+	std::lock_guard<std::mutex> lk(m_statsMutex);
+	m_loops.push_back(*ev);
+}
+
+std::optional<LoopClosureEvent> System::closeLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
+{
+	if (!m_loopCloser) return std::nullopt;
 	const auto t0 = std::chrono::steady_clock::now();
 	auto ev = m_loopCloser->process(job.keyframe, job.frameIndex, job.K);
 	m_timings.add("loop_closing", secondsSince(t0));
-	if (!ev) return;
+	if (!ev) return std::nullopt;
 	m_map.noteCorrection();
 	if (tf)
 	{
@@ -163,8 +209,7 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 		for (const auto& [name, sec] : m_maps->applyCorrection(ev->newPoses)) m_timings.add("map_correction:" + name, sec);
 		m_maps->notifyLoopClosure();
 	}
-	std::lock_guard<std::mutex> lk(m_statsMutex);
-	m_loops.push_back(std::move(*ev));
+	return ev;
 }
 
 void System::waitForMapping()
@@ -276,7 +321,7 @@ void System::finish()
 	if (m_finished || !m_K || m_map.numKeyFrames() == 0) return;
 	m_finished = true;
 	const auto t0 = std::chrono::steady_clock::now();
-	if (m_cfg.refinement.globalBundleAdjustment && m_map.numKeyFrames() > 1)
+	if (m_cfg.refinement.globalBundleAdjustment && m_map.numKeyFrames() > 1 && !m_localizeOnly)
 	{
 		auto o = m_cfg.mapping.ba;
 		o.iterations = m_cfg.refinement.globalIterations;
@@ -285,7 +330,7 @@ void System::finish()
 		m_globalBa = sfm::globalBundleAdjustment(m_map, *m_K, o);
 	}
 	m_timings.add("global_bundle_adjustment", secondsSince(t0));
-	if (m_maps)
+	if (m_maps && !m_localizeOnly)
 	{
 		// Re-anchor the maps on the refined keyframe poses (erased keyframes via their parents).
 		std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> poses;
@@ -296,6 +341,22 @@ void System::finish()
 		}
 		for (const auto& [name, sec] : m_maps->applyCorrection(poses)) m_timings.add("map_correction:" + name, sec);
 		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+	}
+	if (m_recorder)
+	{
+		const auto t2 = std::chrono::steady_clock::now();
+		try
+		{
+			noteRunAttributes();
+			m_recorder->finish(m_map, m_loopCloser.get(), m_maps.get());
+		}
+		catch (const std::exception& e)
+		{
+			// The other outputs are still written; the error is reported with them.
+			std::lock_guard<std::mutex> lk(m_statsMutex);
+			if (m_backgroundError.empty()) m_backgroundError = std::string("session store: ") + e.what();
+		}
+		m_timings.add("session_store", secondsSince(t2));
 	}
 	if (!m_cfg.refinement.refineFrames) return;
 	const auto t1 = std::chrono::steady_clock::now();

@@ -33,9 +33,9 @@ void ImageCodecOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& 
 
 void ImageCodecOptions::saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const
 {
-	cfg.write(section, "colour_format", colourFormat);
-	cfg.write(section, "png_compression", pngCompression);
-	cfg.write(section, "jpeg_quality", jpegQuality);
+	cfg.write(section, "colour_format", colourFormat, 30, 40, "png (lossless) | jpg");
+	cfg.write(section, "png_compression", pngCompression, 30, 40, "zlib level of the PNGs, 0..9");
+	cfg.write(section, "jpeg_quality", jpegQuality, 30, 40, "1..100, colour_format = jpg");
 }
 
 KeyFrameImageCodec::KeyFrameImageCodec(const ImageCodecOptions& opts) : m_opts(opts)

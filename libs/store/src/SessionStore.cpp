@@ -299,6 +299,9 @@ void SessionStore::Impl::loadMeta()
 	c.cy = num("camera_cy");
 	c.dist = {num("camera_k1"), num("camera_k2"), num("camera_p1"), num("camera_p2"), num("camera_k3")};
 	c.depthUnits = static_cast<float>(num("camera_depth_units"));
+	meta.attributes.clear();
+	for (const auto& [k, v] : kv)
+		if (k.rfind("run.", 0) == 0) meta.attributes[k] = v;
 }
 
 SessionStore::SessionStore(std::unique_ptr<Impl> impl) : m_impl(std::move(impl)) {}

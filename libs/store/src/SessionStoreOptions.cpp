@@ -32,10 +32,10 @@ void SessionStoreOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase
 
 void SessionStoreOptions::saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const
 {
-	cfg.write(section, "durability", durability);
-	cfg.write(section, "cache_size_kib", cacheSizeKiB);
-	cfg.write(section, "busy_timeout_ms", busyTimeoutMs);
-	cfg.write(section, "integrity_check", integrityCheck);
+	cfg.write(section, "durability", durability, 30, 40, "full (commits survive power loss) | normal (survive a killed process)");
+	cfg.write(section, "cache_size_kib", cacheSizeKiB, 30, 40, "SQLite page cache [KiB]");
+	cfg.write(section, "busy_timeout_ms", busyTimeoutMs, 30, 40, "wait for another connection's lock [ms]");
+	cfg.write(section, "integrity_check", integrityCheck, 30, 40, "quick (read every page on open) | none");
 }
 
 }  // namespace keygrid::store

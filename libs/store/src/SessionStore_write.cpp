@@ -164,6 +164,17 @@ void SessionStore::write(const SessionUpdate& u)
 				throw std::invalid_argument("SessionStore::write: new pose for keyframe " + std::to_string(p.id) +
 											", which '" + path() + "' does not hold");
 		}
+		for (const auto& a : u.associations)
+		{
+			const auto lms = packArray(a.landmarks);
+			auto& st = im.statement("UPDATE keyframes SET landmarks = ?1 WHERE id = ?2 AND num_keypoints = ?3");
+			st.bindBlob(1, lms).bind(2, sqlId(a.id)).bind(3, std::int64_t(a.landmarks.size()));
+			st.run();
+			if (sqlite3_changes(im.db.handle()) != 1)
+				throw std::invalid_argument("SessionStore::write: landmarks of keyframe " + std::to_string(a.id) + " (" +
+											std::to_string(a.landmarks.size()) + " keypoints), which '" + path() +
+											"' does not hold with that many keypoints");
+		}
 		for (const auto& lm : u.landmarks)
 		{
 			const auto desc = packMat(lm.descriptor);
@@ -235,7 +246,16 @@ void SessionStore::write(const SessionUpdate& u)
 			st.bind(1, s.name).bind(2, sqlId(s.lastKeyFrame)).bindBlob(3, s.data);
 			st.run();
 		}
+		for (const auto& [key, value] : u.attributes)
+		{
+			if (key.rfind("run.", 0) != 0 || key.size() == 4)
+				throw std::invalid_argument("SessionStore::write: attribute '" + key + "' (names start with 'run.')");
+			auto& st = im.statement("INSERT INTO meta(key, value) VALUES(?1, ?2) ON CONFLICT(key) DO UPDATE SET value = excluded.value");
+			st.bind(1, key).bind(2, value);
+			st.run();
+		}
 		tx.commit();
+		for (const auto& [key, value] : u.attributes) im.meta.attributes[key] = value;
 	}
 	catch (...)
 	{

@@ -46,6 +46,8 @@ int EvalApp::run(int argc, const char* const* argv)
 			.option("overlay", "OUT.png", "write the map laid over the floor plan (occupied / free / missed / hazard / false obstacle)")
 			.option("tolerance", "M", "occupied cells match within this distance", false, "0.05")
 			.option("max-range", "M", "horizontal range of the cameras' view for --scene", false, "4.5")
+			.option("map-run-gt", "GT1.txt", "with --map-run-est: measure --est in a stored map's frame, fixed by the mapping run's poses (orientations and positions) against this ground truth (localization runs: not re-aligned)")
+			.option("map-run-est", "EST1.txt", "the mapping run's trajectory (keygrid-slam --map), with --map-run-gt")
 			.flag("sim3", "align with scale (for monocular or scale-drifting estimates)")
 			.flag("skip-bad-lines", "skip malformed lines (reported) instead of failing")
 			.flag("quiet", "no progress output");
@@ -86,6 +88,13 @@ int EvalApp::run(int argc, const char* const* argv)
 		const auto gt = core::readTumTrajectory(cl.get("gt"), ro, &issues);
 		const auto est = core::readTumTrajectory(cl.get("est"), ro, &issues);
 		for (const auto& is : issues) std::cerr << "keygrid-eval: skipped " << is.str() << "\n";
+		if (cl.has("map-run-gt") != cl.has("map-run-est")) throw core::CommandLineError("--map-run-gt and --map-run-est go together");
+		if (cl.has("map-run-gt"))
+		{
+			const auto gt1 = core::readTumTrajectory(cl.get("map-run-gt"), ro, &issues);
+			const auto est1 = core::readTumTrajectory(cl.get("map-run-est"), ro, &issues);
+			opts.fixedAlignment = eval::alignTrajectoryPoses(gt1, est1, opts.maxDt);
+		}
 		const auto res = eval::evaluateTrajectory(gt, est, opts);
 		std::cout << res.toText();
 		std::string json = res.toJson();

@@ -12,6 +12,7 @@
 #include <keygrid/slam/SimpleMapExport.h>
 #include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/System.h>
+#include <keygrid/store/SessionStore.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/BatchExperiment.h>
 #include <keygrid/slam/apps/SlamApp.h>
@@ -126,10 +127,22 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (!o.groundTruth.empty()) gt = core::readTumTrajectory(o.groundTruth);
 
 	System sys(cfg);
+	std::optional<LoadedSession> loaded;
+	if (!o.loadMap.empty())
 	{
+		const auto session = store::SessionStore::Open(o.loadMap, store::SessionStore::Mode::ReadOnly, cfg.store.sqlite);
+		loaded = sys.loadSession(session, o.localize);
+		if (!o.quiet)
+			std::cerr << "keygrid-slam: loaded " << o.loadMap << ": " << loaded->keyframes << " keyframes, " << loaded->landmarks
+					  << " landmarks (" << loaded->seconds << " s)" << (o.localize ? ", localization only" : "") << "\n";
+	}
+	if (!sys.localizeOnly())
+	{
+		// Localization adds no keyframes: no map is fed.
 		auto maps = std::make_unique<MetricMaps>(ini, cfg.maps, cfg.floor);
 		if (!maps->empty()) sys.attachMaps(std::move(maps));
 	}
+	if (!o.mapFile.empty()) sys.attachRecorder(std::make_unique<SessionRecorder>(o.mapFile, cfg.store));
 	SlamRunResult res;
 	const std::size_t total = o.maxFrames ? std::min(o.maxFrames, input.sizeHint().value_or(o.maxFrames)) : input.sizeHint().value_or(0);
 	core::ProgressBar bar("keygrid-slam", total, !o.quiet);
@@ -167,6 +180,9 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			std::thread producer([&] {
 				try
 				{
+					core::Frame skippedFrame;
+					for (std::size_t n = 0; n < o.firstFrame && !interruptRequested(); n++)
+						if (!source->next(skippedFrame)) break;
 					for (std::size_t n = 0; !limitReached(n) && !interruptRequested(); n++)
 					{
 						Extracted e;
@@ -227,8 +243,17 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (res.error.empty()) res.error = sys.backgroundError();
 	const double wall = since(tStart);
 
-	const auto traj = sys.trajectory();
-	writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, "keygrid-slam trajectory, every frame"));
+	auto traj = sys.trajectory();
+	if (sys.localizeOnly())
+	{
+		// A frame not localized has no pose in the map: only the localized ones are listed.
+		core::Trajectory localized;
+		for (std::size_t i = 0; i < traj.size() && i < sys.frames().size(); i++)
+			if (sys.frames()[i].tracked) localized.push_back(traj[i]);
+		traj = std::move(localized);
+		res.localized = traj.size();
+	}
+	writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, sys.localizeOnly() ? "keygrid-slam trajectory in the loaded map's frame, every localized frame" : "keygrid-slam trajectory, every frame"));
 	// The run's floor frame (any map configured): every map output is written in it.
 	const std::optional<mrpt::poses::CPose3D> T_world_floor =
 		sys.metricMaps() ? sys.metricMaps()->T_world_floor() : std::nullopt;
@@ -248,13 +273,16 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	}
 	{
 		std::ostringstream csv;
-		csv << "index,timestamp,tracked,method,matches,inliers,new_keyframe,reference_keyframe,landmarks\n";
+		// Localization mode: a last column says whether each frame was localized in the map.
+		csv << "index,timestamp,tracked,method,matches,inliers,new_keyframe,reference_keyframe,landmarks"
+			<< (sys.localizeOnly() ? ",status\n" : "\n");
 		for (const auto& f : sys.frames())
 		{
-			char line[160];
-			std::snprintf(line, sizeof(line), "%zu,%.6f,%d,%s,%d,%d,%d,%lld,%zu\n", f.index, f.timestamp, f.tracked ? 1 : 0,
+			char line[180];
+			std::snprintf(line, sizeof(line), "%zu,%.6f,%d,%s,%d,%d,%d,%lld,%zu%s\n", f.index, f.timestamp, f.tracked ? 1 : 0,
 						  f.method.c_str(), f.matches, f.inliers, f.newKeyFrame ? 1 : 0,
-						  f.hasReference ? static_cast<long long>(f.reference) : -1LL, f.mapLandmarks);
+						  f.hasReference ? static_cast<long long>(f.reference) : -1LL, f.mapLandmarks,
+						  !sys.localizeOnly() ? "" : f.tracked ? ",localized" : ",lost");
 			csv << line;
 		}
 		writeFileAtomically(o.output + "/frames.csv", csv.str());
@@ -262,7 +290,8 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	writeFileAtomically(o.output + "/keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
 	try
 	{
-		writeKeyframesSimpleMap(sys.map(), o.output + "/keyframes.simplemap");
+		// A loaded map's keyframes have their images in the session file, not here.
+		if (!sys.localizeOnly()) writeKeyframesSimpleMap(sys.map(), o.output + "/keyframes.simplemap");
 	}
 	catch (const std::exception& e)
 	{
@@ -408,6 +437,31 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		js << l;
 	}
 	js << "],\n";
+	if (loaded)
+	{
+		char l[400];
+		std::snprintf(l, sizeof(l),
+					  "  \"session\": {\"loaded\": \"%s\", \"mode\": \"%s\", \"keyframes\": %zu, \"landmarks\": %zu, \"load_s\": %.3f, "
+					  "\"localized\": %zu, \"lost\": %zu, \"localized_ratio\": %.4f},\n",
+					  jsonEscape(o.loadMap).c_str(), o.localize ? "localize" : "extend", loaded->keyframes, loaded->landmarks, loaded->seconds,
+					  st.tracked, st.lost, st.frames ? static_cast<double>(st.tracked) / static_cast<double>(st.frames) : 0.0);
+		js << l;
+	}
+	if (const SessionRecorder* rec = sys.recorder())
+	{
+		const auto rs = rec->stats();
+		const auto ws = rec->writerStats();
+		std::error_code ec;
+		const auto bytes = std::filesystem::file_size(rec->path(), ec);
+		char l[512];
+		std::snprintf(l, sizeof(l),
+					  "  \"session\": {\"recorded\": \"%s\", \"updates\": %zu, \"keyframes_written\": %zu, \"landmarks_written\": %zu, "
+					  "\"snapshots\": %zu, \"build_ms_per_update\": %.3f, \"writer_encode_s\": %.3f, \"writer_commit_s\": %.3f, \"file_mb\": %.3f},\n",
+					  jsonEscape(rec->path()).c_str(), rs.updates, rs.keyframesWritten, rs.landmarksWritten, rs.snapshots,
+					  rs.updates ? 1e3 * rs.buildSeconds / static_cast<double>(rs.updates) : 0.0, ws.encodeSeconds, ws.writeSeconds,
+					  ec ? 0.0 : static_cast<double>(bytes) / (1024.0 * 1024.0));
+		js << l;
+	}
 	js << "  \"maps\": " << (sys.metricMaps() ? sys.metricMaps()->summaryJson() : std::string("[]")) << ",\n";
 	js << "  \"floor\": " << (sys.metricMaps() ? sys.metricMaps()->floor().toJson() : std::string("null")) << ",\n";
 	{
@@ -467,6 +521,10 @@ int SlamApp::run(int argc, const char* const* argv)
 			.option("mode", "sequential|threaded", "override [slam] mode")
 			.option("camera", "PRESET|FILE.ini", "override [slam] camera (TUM folders)")
 			.option("max-frames", "N", "stop after N frames", false, "0 (all)")
+			.option("first-frame", "N", "skip the first N input frames", false, "0")
+			.option("map", "FILE", "record the run into a new session file (keyframes, landmarks, images, map snapshots; doc/session-store.md)")
+			.option("load-map", "FILE", "start from a stored session (with --localize)")
+			.flag("localize", "with --load-map: track in the stored map without adding to it; FILE is not changed")
 			.option(
 				"set", "SECTION.KEY=V[;...]",
 				"override configuration keys without editing the file, e.g. 'hoc.enabled=true; "
@@ -526,6 +584,20 @@ int SlamApp::run(int argc, const char* const* argv)
 			if (n < 0) throw core::CommandLineError("--max-frames must be >= 0");
 			o.maxFrames = static_cast<std::size_t>(n);
 		}
+		if (cl.has("first-frame"))
+		{
+			const long n = cl.getInt("first-frame");
+			if (n < 0) throw core::CommandLineError("--first-frame must be >= 0");
+			o.firstFrame = static_cast<std::size_t>(n);
+		}
+		if (cl.has("map")) o.mapFile = cl.get("map");
+		if (cl.has("load-map")) o.loadMap = cl.get("load-map");
+		o.localize = cl.flagSet("localize");
+		if (o.localize && o.loadMap.empty()) throw core::CommandLineError("--localize needs --load-map FILE");
+		if (!o.loadMap.empty() && !o.localize)
+			throw core::CommandLineError("--load-map needs --localize (continuing a stored map is not supported yet)");
+		if (live && o.firstFrame) throw core::CommandLineError("--first-frame is for recorded inputs, not --live");
+		if (!o.loadMap.empty() && !o.mapFile.empty()) throw core::CommandLineError("--map and --load-map --localize exclude each other (localization does not record)");
 		o.quiet = cl.flagSet("quiet");
 		o.live = live;
 		o.preview = live && !cl.flagSet("no-preview") && (cl.flagSet("preview") || LivePreview::displayAvailable());

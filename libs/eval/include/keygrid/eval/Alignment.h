@@ -30,6 +30,17 @@ struct Similarity3
 Similarity3 alignPointSets(
 	const std::vector<Eigen::Vector3d>& x, const std::vector<Eigen::Vector3d>& y, bool withScale);
 
+/** The rotation R minimising sum_k |Ry_k - R Rx_k|_F^2 (chordal L2 mean of Ry_k Rx_k^T): the
+ * polar factor U W V^T of M = sum_k Ry_k Rx_k^T = U D V^T, W = diag(1, 1, sign(det(U V^T))).
+ * Throws std::invalid_argument when the sizes differ or there is none. */
+Eigen::Matrix3d chordalMeanRotation(const std::vector<Eigen::Matrix3d>& Rx, const std::vector<Eigen::Matrix3d>& Ry);
+
+/** Rigid alignment of two sets of poses (camera frames), T_y_x: R = chordalMeanRotation of
+ * their orientations, t = mean_k (p_y_k - R p_x_k), s = 1. Unlike alignPointSets it is well
+ * posed when the positions barely spread (a camera turning on the spot), because the
+ * orientations fix the rotation. Needs at least one pair. */
+Similarity3 alignPoses(const std::vector<mrpt::poses::CPose3D>& x, const std::vector<mrpt::poses::CPose3D>& y);
+
 /** The rotation and translation of an alignment as a pose (the scale dropped): T_y_x. */
 mrpt::poses::CPose3D rigidPose(const Similarity3& a);
 

@@ -19,6 +19,10 @@ struct TrajectoryErrorOptions
 	bool withScale{false};
 	/** RPE time step [s] (Default: 1 s, so RPE is per second) */
 	double rpeDelta{1.0};
+	/** When set, this alignment (estimate frame -> ground-truth frame) is used instead of
+	 * the one fitted to the trajectory: errors in a frame fixed beforehand, e.g. a stored map's
+	 * frame as the mapping run's alignment gives it (localization is not re-aligned). */
+	std::optional<Similarity3> fixedAlignment;
 
 	bool isValid(std::string* error = nullptr) const;
 };
@@ -50,6 +54,13 @@ struct TrajectoryErrors
 	/** A few human-readable lines. */
 	std::string toText() const;
 };
+
+/** The frame of a run's estimate in the ground-truth world: alignPoses() over the poses whose
+ * timestamps match within maxDt [s] (orientations and positions, so a camera that turns on
+ * the spot still fixes it). A stored map's frame, for measuring a localization run in it
+ * (TrajectoryErrorOptions::fixedAlignment). Throws std::invalid_argument when fewer than 3
+ * poses match. */
+Similarity3 alignTrajectoryPoses(const core::Trajectory& gt, const core::Trajectory& est, double maxDt = 0.02);
 
 /** Evaluates `est` against `gt`. Throws std::invalid_argument when fewer than 3 poses match. */
 TrajectoryErrors evaluateTrajectory(

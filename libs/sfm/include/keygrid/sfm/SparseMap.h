@@ -72,6 +72,14 @@ class SparseMap
    public:
 	/** Adds a keyframe (its id is assigned here) and returns it. */
 	KeyFrame& addKeyFrame(KeyFrame kf);
+	/** Puts back a keyframe with its own id (a map loaded from a session store); later
+	 * addKeyFrame() ids follow the largest one. Throws std::invalid_argument when the id is
+	 * taken. Covisibility and landmarks are the caller's (restoreLandmark, updateCovisibility). */
+	KeyFrame& restoreKeyFrame(KeyFrame kf);
+	/** Puts back a landmark with its own id and observations; each observing keyframe must be in
+	 * the map already (its keypoint is pointed at the landmark). Throws std::invalid_argument
+	 * when the id is taken or an observation names a missing keyframe or keypoint. */
+	void restoreLandmark(Landmark lm);
 	/** Creates a landmark observed by keypoint kp of keyframe kf. */
 	LandmarkId addLandmark(const Eigen::Vector3d& p_world, KeyFrameId kf, int kp);
 	void addObservation(LandmarkId lm, KeyFrameId kf, int kp);

@@ -80,6 +80,19 @@ class Tracker
 	TrackedFrame track(const core::Frame& frame, FrameFeatures features);
 
 	TrackingState state() const { return m_state; }
+	/** The map was loaded (a stored session): the next frame relocalizes in it (vocabulary
+	 * tree, then the newest keyframes) instead of starting a new map. */
+	void startInLoadedMap() { m_state = TrackingState::Lost; }
+	/** false: localization only, no keyframe is created (the map stays as loaded apart from
+	 * the landmarks' visibility counters and HOC histograms). (Default: true) */
+	void setKeyFrameInsertion(bool on) { m_insertKeyFrames = on; }
+	/** Median share of the local map in view matched by the recently tracked frames (the
+	 * yardstick of a relocalization, see TrackerOptions::relocalizationShareFactor); nullopt
+	 * before the first tracked frame. */
+	std::optional<double> recentShareMedian() const;
+	/** A loaded map: the yardstick as the mapping run left it, for the first relocalization
+	 * (later frames replace it). */
+	void seedRecentShare(double share) { m_recentShares.assign(1, share); }
 	/** After a map correction (loop closure) moved the last tracked frame: its new pose. The
 	 * motion model (relative) stays valid. */
 	void onMapCorrected(const mrpt::poses::CPose3D& T_world_lastFrame) { m_lastPose = T_world_lastFrame; }
@@ -166,6 +179,7 @@ class Tracker
 	PlaceRecognizer m_placeRecognizer;
 	std::function<bool()> m_mappingBusy;  //!< see deferKeyFramesWhile (empty: never deferred)
 	double m_deferWeakRatio{0};  //!< set with m_mappingBusy
+	bool m_insertKeyFrames{true};  //!< see setKeyFrameInsertion
 	bool m_relocRecognized{false};  //!< the last relocalize() succeeded on a recognized place
 	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
 };

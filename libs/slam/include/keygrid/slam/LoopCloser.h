@@ -62,6 +62,8 @@ struct LoopClosureEvent
 	/** The verified relative pose T_loop_cur: distance between the two cameras [m] and the
 	 * angle between them [deg] */
 	double measuredDistance{0}, measuredAngleDeg{0};
+	/** The verified measurement: pose of `keyframe` in `loopKeyFrame` */
+	mrpt::poses::CPose3D T_loop_cur;
 	double score{0};
 	int inliers{0};
 	double correctionMetres{0};  //!< how far the current keyframe moved
@@ -112,6 +114,17 @@ class LoopCloser
 	std::vector<sfm::KeyFrameId> placeCandidates(const cv::Mat& descriptors, int maxCandidates) const;
 
 	bool hasVocabulary() const { return !m_vocab.empty(); }
+	/** The vocabulary file; empty when the vocabulary is trained in the run or was stored in a
+	 * session (useVocabulary). */
+	const std::string& vocabularyFile() const { return m_vocabFile; }
+	/** Replaces the vocabulary (a loaded session's, trained in its run and stored in the file);
+	 * `source` names it in reports. Clears the keyframe database. */
+	void useVocabulary(loop::Vocabulary vocabulary, const std::string& source);
+	/** Adds every keyframe of the map that is not in the keyframe database yet (a map loaded
+	 * from a session), its BoW vector computed from its descriptors. No-op without vocabulary. */
+	void indexKeyFrames();
+	/** The BoW vector of a keyframe in the database; nullptr when it is not there. */
+	const loop::BowVector* bowOf(sfm::KeyFrameId kf) const { return m_db.contains(kf) ? &m_db.bow(kf) : nullptr; }
 	const loop::Vocabulary& vocabulary() const { return m_vocab; }
 	/** One record per keyframe handled by process(), in order. */
 	const std::vector<LoopQueryRecord>& queries() const { return m_queries; }
@@ -136,7 +149,8 @@ class LoopCloser
 	LoopClosingOptions m_opts;
 	sfm::MatcherOptions m_matcher;
 	loop::Vocabulary m_vocab;
-	std::string m_vocabFile;  //!< empty: trained in the run
+	std::string m_vocabFile;  //!< empty: trained in the run or loaded with a session
+	std::string m_vocabSource;  //!< useVocabulary()'s source, for reports
 	loop::KeyFrameDatabase m_db;
 	std::set<sfm::KeyFrameId> m_dbIds;
 	loop::ConsistencyChecker m_consistency;

@@ -5,7 +5,7 @@
  * Sections: [slam] (mode, camera), [features], [tracker], [mapping] (local mapping and local
  * bundle adjustment), [refinement] (final global bundle adjustment and frame re-estimation),
  * [loop_closing] (place recognition and pose graph), [maps] (how keyframes feed the maps), [floor]
- * (the floor frame every map output is written in) and [MappingApplication] (the maps themselves, MRPT's
+ * (the floor frame every map output is written in), [store] (the session file of --map) and [MappingApplication] (the maps themselves, MRPT's
  * CMultiMetricMap format, see MetricMaps). Keys absent from the file keep their documented defaults.
  */
 #include <keygrid/sfm/FeatureExtractor.h>
@@ -13,6 +13,7 @@
 #include <keygrid/sfm/TrackerOptions.h>
 #include <keygrid/slam/LoopCloser.h>
 #include <keygrid/slam/MetricMaps.h>
+#include <keygrid/slam/SessionRecorder.h>
 
 #include <string>
 
@@ -63,6 +64,7 @@ struct SlamConfig
 	MapFeedOptions maps;
 	maps::FloorFrameOptions floor;
 	LoopClosingOptions loop;
+	SessionRecorderOptions store;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;

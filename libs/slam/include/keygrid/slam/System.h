@@ -18,6 +18,8 @@
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/slam/LoopCloser.h>
 #include <keygrid/slam/MetricMaps.h>
+#include <keygrid/slam/SessionLoader.h>
+#include <keygrid/slam/SessionRecorder.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <keygrid/slam/StageTimings.h>
 
@@ -51,6 +53,10 @@ struct SystemStats
 class System
 {
    public:
+	/** Session attribute: median share of the local map matched by tracking (see
+	 * Tracker::recentShareMedian), the yardstick of relocalizing in the stored map. */
+	static constexpr const char* kTrackingShareAttribute = "run.tracking_share_median";
+
 	/** Starts the mapping and loop-closing threads when cfg.mode is "threaded". */
 	explicit System(const SlamConfig& cfg);
 	/** Stops and joins the threads (what they had queued is still processed). */
@@ -68,6 +74,18 @@ class System
 	/** Maps fed with every keyframe (optional; see MetricMaps). */
 	void attachMaps(std::unique_ptr<MetricMaps> maps) { m_maps = std::move(maps); }
 	const MetricMaps* metricMaps() const { return m_maps.get(); }
+
+	/** Records the run into a session file (keygrid-slam --map): each keyframe after its local
+	 * mapping and loop closing, the rest in finish(). Before the first frame. */
+	void attachRecorder(std::unique_ptr<SessionRecorder> recorder) { m_recorder = std::move(recorder); }
+	const SessionRecorder* recorder() const { return m_recorder.get(); }
+	/** Loads a stored session's map before the first frame; the first frame relocalizes in it.
+	 * `localizeOnly`: no keyframes are added, the map is not refined at the end (finish() only
+	 * re-estimates the frames). The loop closer, when enabled, takes the session's stored
+	 * vocabulary if its own is to be trained in the run, and indexes the loaded keyframes for
+	 * relocalization. Throws std::logic_error after the first frame. */
+	LoadedSession loadSession(const store::SessionStore& session, bool localizeOnly);
+	bool localizeOnly() const { return m_localizeOnly; }
 
 	/** After the last frame: waits for the mapping and loop-closing threads to process every
 	 * queued keyframe, then global bundle adjustment and frame re-estimation, as configured in
@@ -115,6 +133,10 @@ class System
 	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
 	 * tracker's last frame, which created the keyframe. */
 	void insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
+	/** Hands the recorder what a later localization in the session needs from this run. */
+	void noteRunAttributes();
+	/** Loop detection and correction of a keyframe (map lock held); the event when one closed. */
+	std::optional<LoopClosureEvent> closeLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
 	void mappingThread();
 	/** Threaded mode, tracking thread: blocks until local mapping is at most [slam]
 	 * mapping_lag keyframes behind (throws if a background thread failed). */
@@ -135,6 +157,8 @@ class System
 	std::optional<sfm::PinholeIntrinsics> m_K;
 	bool m_finished{false};
 	std::unique_ptr<MetricMaps> m_maps;
+	std::unique_ptr<SessionRecorder> m_recorder;
+	bool m_localizeOnly{false};
 	std::unique_ptr<LoopCloser> m_loopCloser;
 	std::vector<LoopClosureEvent> m_loops;
 	std::optional<sfm::BundleAdjusterReport> m_globalBa;

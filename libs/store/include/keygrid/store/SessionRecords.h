@@ -54,6 +54,9 @@ struct SessionMeta
 	VocabularyIdentity vocabulary;
 	/** The session's main camera (each keyframe also names its own, see KeyFrameRecord) */
 	core::RgbdCamera camera;
+	/** Facts about the mapping run its users want back (e.g. "run.tracking_share_median",
+	 * see doc/session-store.md): meta rows whose key starts with "run." */
+	std::map<std::string, std::string> attributes;
 };
 
 /** A keyframe without its images; images live apart and are loaded on demand
@@ -161,6 +164,15 @@ struct KeyFramePose
 	mrpt::poses::CPose3D T_world_cam;
 };
 
+/** The keypoint -> landmark association of a stored keyframe, when it changed after the
+ * keyframe was written (landmarks triangulated later from its keypoints, fused or culled);
+ * one entry per keypoint, kNoLandmark where none. */
+struct KeyFrameLandmarks
+{
+	KeyFrameId id{0};
+	std::vector<LandmarkId> landmarks;
+};
+
 /** A metric map in MRPT's own serialization, gz-compressed: the same bytes MetricMaps writes
  * to its *.bin files (see MapSnapshotCodec). One snapshot per name; a newer one replaces it. */
 struct MapSnapshot
@@ -175,8 +187,8 @@ struct MapSnapshot
 
 /** Everything one SessionStore::write() commits atomically: typically one new keyframe with
  * the landmarks and edges the mapping step created or changed. Applied in the order of the
- * fields: keyframes (+ images), poses, landmarks, erased landmarks, erased keyframes,
- * covisibility, loops, snapshots. */
+ * fields: keyframes (+ images), poses, associations, landmarks, erased landmarks, erased
+ * keyframes, covisibility, loops, snapshots, attributes. */
 struct SessionUpdate
 {
 	/** New keyframes (an existing id is replaced) and their images, same order; `images` may be
@@ -185,6 +197,8 @@ struct SessionUpdate
 	std::vector<EncodedImages> images;
 	/** Changed poses of stored keyframes */
 	std::vector<KeyFramePose> poses;
+	/** Changed keypoint -> landmark associations of stored keyframes */
+	std::vector<KeyFrameLandmarks> associations;
 	/** New or changed landmarks (upsert by id) */
 	std::vector<LandmarkRecord> landmarks;
 	/** Removed keyframes (also their images and covisibility edges) and landmarks */
@@ -193,6 +207,8 @@ struct SessionUpdate
 	std::vector<CovisibilityEdge> covisibility;
 	std::vector<LoopConstraint> loops;
 	std::vector<MapSnapshot> snapshots;
+	/** Upserted into SessionMeta::attributes; every key must start with "run." */
+	std::map<std::string, std::string> attributes;
 };
 
 /** Row counts of a store. */

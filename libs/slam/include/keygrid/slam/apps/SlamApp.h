@@ -18,6 +18,14 @@ struct SlamRunOptions
 	 * (keygrid-slam --set); every key must exist in the file or in keygrid-slam's options. */
 	std::string set;
 	std::size_t maxFrames{0};  //!< 0 = all
+	/** Input frames skipped before the first processed one (0 = none) */
+	std::size_t firstFrame{0};
+	/** --map: a new session file the run is recorded into (empty: none) */
+	std::string mapFile;
+	/** --load-map: a stored session loaded before the first frame (empty: none) */
+	std::string loadMap;
+	/** --localize (with loadMap): track in the loaded map without changing it */
+	bool localize{false};
 	bool quiet{false};
 	/** Grab from the OpenNI2 camera of the config's [live] section instead of `input` */
 	bool live{false};
@@ -35,6 +43,8 @@ struct SlamRunResult
 	/** The frame loop was stopped by interruptRequested() (Ctrl-C / SIGTERM) */
 	bool interrupted{false};
 	std::size_t liveGrabbed{0}, liveDropped{0};  //!< live runs: camera frames, and those skipped
+	/** Localization mode: frames localized in the loaded map */
+	std::size_t localized{0};
 };
 
 /** Runs one sequence end to end; throws on bad configuration or unopenable input. */

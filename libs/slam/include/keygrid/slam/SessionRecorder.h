@@ -1,0 +1,129 @@
+#pragma once
+/** \file SessionRecorder.h
+ * Writes a keygrid-slam run into a session file (keygrid-slam --map FILE, doc/session-store.md)
+ * while it maps: after each keyframe's local mapping and loop closing, what changed in the
+ * sparse map since the last update goes to the store as one transaction (store::SessionWriter:
+ * image compression and the commit run on the writer's thread). A run killed at any moment
+ * leaves the file consistent up to the last committed keyframe.
+ *
+ * What changed is found by comparing the map with what was written: new, moved and erased
+ * keyframes; landmarks whose position, observations or descriptor differ; the keypoint ->
+ * landmark association of keyframes whose landmarks changed; covisibility edges. Tracking
+ * updates the visibility counters and HOC histograms of every landmark in view at every
+ * frame: those are written with the landmark's other changes and all of them at the end, so a
+ * killed run keeps them as of each landmark's last write.
+ * The metric maps are stored as snapshots every `snapshot_every` keyframes and at the end.
+ */
+#include <keygrid/sfm/SparseMap.h>
+#include <keygrid/store/SessionWriter.h>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace keygrid::slam
+{
+class LoopCloser;
+class MetricMaps;
+struct LoopClosureEvent;
+
+/** INI section [store]: the session file of keygrid-slam --map / --load-map. */
+struct SessionRecorderOptions
+{
+	/** Store each keyframe's colour and depth images (needed to rebuild the dense maps and for
+	 * keyframes.simplemap of an exported session) (Default: true) */
+	bool images{true};
+	/** Snapshot of the metric maps every this many keyframes, and always at the end; 0 = at
+	 * the end only (Default: 25) */
+	int snapshotEvery{25};
+	/** SQLite durability, cache, lock timeout, integrity check on open */
+	store::SessionStoreOptions sqlite;
+	/** Compression of the keyframe images */
+	store::ImageCodecOptions codec;
+
+	/** Throws std::invalid_argument naming the key when a value is invalid. */
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+};
+
+/** Counters for report.json. */
+struct SessionRecorderStats
+{
+	std::size_t updates{0}, keyframesWritten{0}, landmarksWritten{0}, snapshots{0};
+	/** Time spent building the updates on the mapping side [s] */
+	double buildSeconds{0};
+};
+
+class SessionRecorder
+{
+   public:
+	/** Creates `path` (which must not exist; std::runtime_error naming it otherwise); the
+	 * file appears with the first keyframe, whose camera becomes the session's camera. */
+	SessionRecorder(const std::string& path, const SessionRecorderOptions& opts);
+	/** Continues a stored session (extend mode): `store` open for writing, the map loaded from
+	 * it; only what changes from now on is written. */
+	SessionRecorder(store::SessionStore store, const sfm::SparseMap& loaded, const SessionRecorderOptions& opts);
+	~SessionRecorder();
+
+	/** After a keyframe went through local mapping and loop closing (map lock held): writes
+	 * what changed. `loop` may be null (no loop closing); `maps` may be null (no metric maps). */
+	void afterKeyFrame(const sfm::SparseMap& map, const LoopCloser* loop, const LoopClosureEvent* closed, const MetricMaps* maps);
+	/** After the final refinement: the last changes and the map snapshots, then waits for the
+	 * writer and closes the file. Throws std::runtime_error naming the file on a write error. */
+	void finish(const sfm::SparseMap& map, const LoopCloser* loop, const MetricMaps* maps);
+
+	/** Waits until every update so far is committed (throws like finish()). */
+	void flush()
+	{
+		if (m_writer) m_writer->flush();
+	}
+	/** A fact about the run (a "run." meta key, see store::SessionMeta::attributes), written
+	 * with the next update. */
+	void setAttribute(const std::string& key, const std::string& value) { m_attributes[key] = value; }
+
+	const std::string& path() const { return m_path; }
+	SessionRecorderStats stats() const;
+	/** Writer thread totals (image compression and commits). */
+	store::SessionWriterStats writerStats() const;
+
+   private:
+	/** What was last written of a keyframe: its pose and covisibility. */
+	struct WrittenKeyFrame
+	{
+		mrpt::poses::CPose3D T_world_cam;
+		std::map<sfm::KeyFrameId, int> covisibility;
+	};
+	/** What was last written of a landmark: a hash of its fields and its observers. */
+	struct WrittenLandmark
+	{
+		std::uint64_t hash{0};
+		std::vector<sfm::KeyFrameId> observers;
+	};
+
+	void open(const sfm::SparseMap& map, const LoopCloser* loop);
+	/** The changes since the last update (and records what is written now). withCounters:
+	 * also landmarks whose only change is in their visibility counters or HOC histogram. */
+	store::SessionWriteJob diff(const sfm::SparseMap& map, const LoopCloser* loop, bool withCounters);
+	void addSnapshots(store::SessionUpdate& u, const sfm::SparseMap& map, const MetricMaps& maps);
+
+	std::string m_path;
+	SessionRecorderOptions m_opts;
+	std::unique_ptr<store::SessionWriter> m_writer;
+	std::unordered_map<sfm::KeyFrameId, WrittenKeyFrame> m_keyframes;
+	std::unordered_map<sfm::LandmarkId, WrittenLandmark> m_landmarks;
+	std::map<std::string, std::string> m_attributes;  //!< for the next update
+	std::size_t m_loopsWritten{0};
+	std::size_t m_keyframesSinceSnapshot{0};
+	bool m_vocabularyNoted{false};
+	bool m_finished{false};
+	SessionRecorderStats m_stats;
+};
+
+/** Hash of what a landmark record holds (position, normal, distances, observations,
+ * descriptor; withCounters: also the visible / found counters and the HOC counts). */
+std::uint64_t landmarkHash(const sfm::Landmark& lm, bool withCounters);
+
+}  // namespace keygrid::slam
