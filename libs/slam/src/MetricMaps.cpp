@@ -143,6 +143,7 @@ void MetricMaps::floorChanged()
 
 maps::ExportFrame MetricMaps::outputFrame() const
 {
+	if (m_restoredFloor) return maps::floorExportFrame(*m_restoredFloor);
 	if (m_floor.T_world_floor()) return maps::floorExportFrame(*m_floor.T_world_floor());
 	return {mrpt::poses::CPose3D(), "keygrid frame: SLAM world (the first camera's optical frame; no floor estimate)"};
 }
@@ -278,6 +279,15 @@ void MetricMaps::notifyLoopClosure()
 {
 	for (auto& m : m_maps.maps)
 		if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get())) g3->notifyLoopClosure();
+}
+
+MetricMaps MetricMaps::FromMaps(
+	const std::vector<mrpt::maps::CMetricMap::Ptr>& maps, const std::optional<mrpt::poses::CPose3D>& T_world_floor)
+{
+	MetricMaps out(MapFeedOptions{}, maps::FloorFrameOptions{});
+	out.m_restoredFloor = T_world_floor;
+	for (const auto& m : maps) out.m_maps.maps.push_back(m);
+	return out;
 }
 
 std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const

@@ -1,3 +1,4 @@
+#include <keygrid/maps/ExportFrame.h>
 #include <keygrid/slam/System.h>
 
 #include <chrono>
@@ -52,6 +53,7 @@ void System::noteRunAttributes()
 {
 	if (const auto share = m_tracker.recentShareMedian())
 		m_recorder->setAttribute(kTrackingShareAttribute, std::to_string(*share));
+	if (m_maps && m_maps->T_world_floor()) m_recorder->setAttribute(kFloorAttribute, maps::poseMatrixText(*m_maps->T_world_floor()));
 }
 
 LoadedSession System::loadSession(const store::SessionStore& session, bool localizeOnly)

@@ -1,5 +1,6 @@
 #include <keygrid/core/CommandLine.h>
 #include <keygrid/slam/apps/AppRunner.h>
+#include <keygrid/slam/SessionExport.h>
 #include <keygrid/slam/apps/MapApp.h>
 #include <keygrid/store/SessionStore.h>
 
@@ -41,6 +42,7 @@ int info(const std::string& path)
 		const auto s = store.loadSnapshot(name);
 		std::cout << "    " << name << ": " << s->data.size() / 1024 << " KiB, up to keyframe " << s->lastKeyFrame << "\n";
 	}
+	for (const auto& [k, v] : m.attributes) std::cout << "  " << std::left << std::setw(27) << k << v << "\n";
 	std::cout << std::setprecision(4) << "  file size          " << static_cast<double>(bytes) / (1024.0 * 1024.0) << " MiB";
 	if (n.keyframes > 0) std::cout << " (" << static_cast<double>(bytes) / 1024.0 / static_cast<double>(n.keyframes) << " KiB per keyframe)";
 	std::cout << "\n";
@@ -84,6 +86,17 @@ int check(const std::string& path, bool images)
 			  << (images ? ", images decoded" : "") << ")\n";
 	return 0;
 }
+int exportTo(const std::string& path, const std::string& dir)
+{
+	const auto r = exportSession(path, dir);
+	std::cout << path << ": " << r.keyframes << " keyframes, " << r.landmarks << " landmarks, " << r.simpleMapEntries
+			  << " keyframes with images in keyframes.simplemap\n";
+	for (const auto& [name, kf] : r.snapshots) std::cout << "  map " << name << " as of keyframe " << kf << "\n";
+	std::cout << "outputs in " << dir << ":";
+	for (const auto& f : r.files) std::cout << " " << f;
+	std::cout << "\n";
+	return 0;
+}
 }  // namespace
 
 int MapApp::run(int argc, const char* const* argv)
@@ -94,14 +107,24 @@ int MapApp::run(int argc, const char* const* argv)
 			"Inspects keygrid session files (keygrid-slam --map FILE; doc/session-store.md).\n"
 			"  keygrid-map info FILE     meta table (versions, vocabulary, camera), row counts, sizes\n"
 			"  keygrid-map check FILE    version + integrity checks, every record read back;\n"
-			"                            exit 1 with the reason when one fails");
-		cl.positionals("info FILE | check FILE", "sub-command and the session file")
-			.flag("images", "check: also decode every keyframe's images");
+			"                            exit 1 with the reason when one fails\n"
+			"  keygrid-map export FILE --output DIR\n"
+			"                            keyframes.txt, the maps of the last snapshot (map_2d.*, map_3d.*,\n"
+			"                            hoc_points.*), keyframes.simplemap; also from a killed run's file");
+		cl.positionals("info FILE | check FILE | export FILE", "sub-command and the session file")
+			.flag("images", "check: also decode every keyframe's images")
+			.option("output", "DIR", "export: output folder, created if missing");
 		if (!cl.parse(argc, argv)) return 0;
 		const auto& pos = cl.positional();
 		if (pos.empty()) throw core::CommandLineError("missing sub-command (info or check)");
-		if (pos[0] != "info" && pos[0] != "check") throw core::CommandLineError("unknown sub-command '" + pos[0] + "'");
+		if (pos[0] != "info" && pos[0] != "check" && pos[0] != "export") throw core::CommandLineError("unknown sub-command '" + pos[0] + "'");
 		if (pos.size() != 2) throw core::CommandLineError(pos[0] + " needs exactly one session file");
+		if (pos[0] == "export")
+		{
+			if (!cl.has("output")) throw core::CommandLineError("export needs --output DIR");
+			return exportTo(pos[1], cl.get("output"));
+		}
+		if (cl.has("output")) throw core::CommandLineError("--output is for export");
 		return pos[0] == "info" ? info(pos[1]) : check(pos[1], cl.flagSet("images"));
 	});
 }

@@ -28,6 +28,13 @@ struct ExportFrame
  * of every map output in the floor frame (the same as map_2d.yaml's first-line comment). */
 std::string floorFrameComment(const mrpt::poses::CPose3D& T_world_floor);
 
+/** A pose as the 12 numbers of its 3x4 matrix [R | t], row by row, with 17 significant digits:
+ * poseFromMatrixText() gives back the same rotation matrix and translation bit for bit (yaw,
+ * pitch, roll text would not: near roll = +-180 deg it may flip the quaternion's sign). */
+std::string poseMatrixText(const mrpt::poses::CPose3D& p);
+/** The pose of poseMatrixText(); throws std::invalid_argument on text that is not 12 numbers. */
+mrpt::poses::CPose3D poseFromMatrixText(const std::string& text);
+
 /** The floor frame as an ExportFrame: T_out_world = inverse(T_world_floor), with its comment. */
 ExportFrame floorExportFrame(const mrpt::poses::CPose3D& T_world_floor);
 

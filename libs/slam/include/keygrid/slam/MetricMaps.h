@@ -55,6 +55,11 @@ class MetricMaps
 		const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed,
 		const maps::FloorFrameOptions& floor = {});
 
+	/** Maps restored elsewhere (a stored session's snapshots, keygrid-map export), for their
+	 * outputs: `T_world_floor` is the floor frame of the run that built them, if it had one. */
+	static MetricMaps FromMaps(
+		const std::vector<mrpt::maps::CMetricMap::Ptr>& maps, const std::optional<mrpt::poses::CPose3D>& T_world_floor);
+
 	bool empty() const { return m_maps.maps.empty(); }
 	std::size_t size() const { return m_maps.maps.size(); }
 	const mrpt::maps::CMultiMetricMap& maps() const { return m_maps; }
@@ -94,12 +99,15 @@ class MetricMaps
 	std::string summaryJson() const;
 
    private:
+	MetricMaps(const MapFeedOptions& feed, const maps::FloorFrameOptions& floor) : m_feed(feed), m_floor(floor) {}
 	std::vector<std::string> writeOutputsInto(const std::string& dir) const;
 
 	mrpt::maps::CMultiMetricMap m_maps;
 	MapFeedOptions m_feed;
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> m_insertedPoses;
 	maps::FloorFrameEstimator m_floor;
+	/** FromMaps(): the floor frame of the run that built the maps */
+	std::optional<mrpt::poses::CPose3D> m_restoredFloor;
 	/** Dense 2D input, per map index: keyframes that arrived before the floor was known. */
 	std::map<std::size_t, std::vector<sfm::KeyFrameId>> m_pendingDense;
 

@@ -56,6 +56,9 @@ class System
 	/** Session attribute: median share of the local map matched by tracking (see
 	 * Tracker::recentShareMedian), the yardstick of relocalizing in the stored map. */
 	static constexpr const char* kTrackingShareAttribute = "run.tracking_share_median";
+	/** Session attribute: the run's floor frame T_world_floor (maps::poseMatrixText), once
+	 * there is one (map outputs of an exported session are written in it). */
+	static constexpr const char* kFloorAttribute = "run.T_world_floor";
 
 	/** Starts the mapping and loop-closing threads when cfg.mode is "threaded". */
 	explicit System(const SlamConfig& cfg);
