@@ -5,6 +5,9 @@
 #include "detail/Grid3DConfig.h"
 
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
+
+#include <algorithm>
+#include <tuple>
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <cmath>
@@ -171,6 +174,9 @@ std::vector<mrpt::math::TPoint3D> CSubmappedOccupancyGrid3D::occupiedVoxelCentre
 	g.forEachKnown([&](const VoxelIndex& vi, const Voxel& v) {
 		if (v.logOdds > 0.0f) pts.push_back(g.centreOf(vi));
 	});
+	// A fixed order (the voxels' hash order depends on the map's history, e.g. a map restored
+	// from its serialization lists them differently): the same map gives the same output.
+	std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z); });
 	return pts;
 }
 

@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <fstream>
 #include <sstream>
-#include <tuple>
 #include <stdexcept>
 
 using namespace keygrid;
@@ -316,9 +315,6 @@ void CSubmappedOccupancyGrid3D::saveAsOctomapBinary(const std::string& path, con
 void CSubmappedOccupancyGrid3D::saveOccupiedAsPly(const std::string& path, const maps::ExportFrame& frame) const
 {
 	auto pts = occupiedVoxelCentres();
-	// A fixed order (the voxels' hash order depends on the map's history, e.g. a map restored
-	// from its serialization lists them differently): the same map gives the same file.
-	std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) { return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z); });
 	if (!frame.isIdentity())
 		for (auto& p : pts) p = frame.T_out_world.composePoint(p);
 	std::ofstream f(path);
