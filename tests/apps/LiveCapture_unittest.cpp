@@ -171,8 +171,9 @@ TEST(LiveCapture, PreviewDrawsKeypointsAndTrackedPoints)
 	std::vector<cv::KeyPoint> kps{cv::KeyPoint(40.f, 80.f, 7.f)};
 	sfm::TrackedFrame tf;
 	tf.tracked = true;
-	sfm::PoseObservation ob;
-	ob.uv = {120.0, 90.0};
+	sfm::FrameObservation ob;
+	ob.u = 120.f;
+	ob.v = 90.f;
 	tf.observations.push_back(ob);
 	const cv::Mat img = slam::LivePreview::render(f, kps, tf, "status");
 	ASSERT_EQ(img.type(), CV_8UC3);

@@ -125,13 +125,18 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 			if (m_recentShares.size() > kRecentShares) m_recentShares.pop_front();
 		}
 		m_lastInliers.clear();
+		// Exactly sized: the run keeps these lists for every frame.
+		const auto inliers = static_cast<std::size_t>(std::count_if(cur.matches.begin(), cur.matches.end(), [](LandmarkId l) { return l != kNoLandmark; }));
+		out.observedLandmarks.reserve(inliers);
+		out.observations.reserve(inliers);
 		for (std::size_t i = 0; i < cur.matches.size(); i++)
 		{
 			const LandmarkId l = cur.matches[i];
 			if (l == kNoLandmark) continue;
 			m_lastInliers.push_back(l);
-			PoseObservation ob;
-			ob.uv = {cur.features.undistorted[i].x, cur.features.undistorted[i].y};
+			FrameObservation ob;
+			ob.u = cur.features.undistorted[i].x;
+			ob.v = cur.features.undistorted[i].y;
 			ob.depth = cur.features.depth[i];
 			ob.invSigma = 1.0 / cur.features.levelScale[cur.features.keypoints[i].octave];
 			out.observedLandmarks.push_back(l);

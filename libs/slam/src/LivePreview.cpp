@@ -41,7 +41,7 @@ cv::Mat LivePreview::render(
 	for (const auto& kp : keypoints) cv::circle(img, kp.pt, 2, cv::Scalar(0, 220, 255), 1, cv::LINE_8);
 	// Tracked inliers are stored undistorted: close enough to the raw image for a preview.
 	for (const auto& ob : tracked.observations)
-		cv::circle(img, cv::Point2f(static_cast<float>(ob.uv.x()), static_cast<float>(ob.uv.y())), 3,
+		cv::circle(img, cv::Point2f(ob.u, ob.v), 3,
 				   cv::Scalar(0, 255, 0), 2, cv::LINE_8);
 	const cv::Scalar textColour = tracked.tracked ? cv::Scalar(0, 255, 0) : cv::Scalar(0, 0, 255);
 	cv::rectangle(img, cv::Point(0, 0), cv::Point(img.cols, 22), cv::Scalar(0, 0, 0), cv::FILLED);

@@ -29,6 +29,15 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	refinement.refineFrames = c.read_bool("refinement", "refine_frames", refinement.refineFrames);
 	if (refinement.globalIterations < 1)
 		throw std::invalid_argument("[refinement] global_iterations = " + std::to_string(refinement.globalIterations) + " (must be >= 1)");
+	refinement.globalMaxKeyFrames = c.read_int("refinement", "global_max_keyframes", refinement.globalMaxKeyFrames);
+	refinement.mapReanchorMinShift = c.read_double("refinement", "map_reanchor_min_shift", refinement.mapReanchorMinShift);
+	refinement.mapReanchorDepth = c.read_double("refinement", "map_reanchor_depth", refinement.mapReanchorDepth);
+	if (refinement.globalMaxKeyFrames < 0)
+		throw std::invalid_argument("[refinement] global_max_keyframes = " + std::to_string(refinement.globalMaxKeyFrames) + " (must be >= 0; 0 = every keyframe)");
+	if (!(refinement.mapReanchorMinShift >= 0))
+		throw std::invalid_argument("[refinement] map_reanchor_min_shift = " + std::to_string(refinement.mapReanchorMinShift) + " (must be >= 0 m)");
+	if (!(refinement.mapReanchorDepth >= 0))
+		throw std::invalid_argument("[refinement] map_reanchor_depth = " + std::to_string(refinement.mapReanchorDepth) + " (must be >= 0 m)");
 	maps.loadFromConfigFile(c, "maps");
 	floor.loadFromConfigFile(c, "floor");
 	loop.loadFromConfigFile(c, "loop_closing");
@@ -50,11 +59,14 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	mapping.saveToConfigFile(c, "mapping");
 	c.write("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment, 30, 40, "bundle-adjust everything after the last frame");
 	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "upper bound on its iterations (it stops on convergence)");
+	c.write("refinement", "global_max_keyframes", refinement.globalMaxKeyFrames, 30, 40, "keyframes it moves at most: around the loops and the newest (0 = all)");
 	maps.saveToConfigFile(c, "maps");
 	floor.saveToConfigFile(c, "floor");
 	loop.saveToConfigFile(c, "loop_closing");
 	store.saveToConfigFile(c, "store");
 	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame that is not a keyframe against the final map");
+	c.write("refinement", "map_reanchor_min_shift", refinement.mapReanchorMinShift, 30, 40, "re-anchor the maps only if a keyframe moved more than this [m]");
+	c.write("refinement", "map_reanchor_depth", refinement.mapReanchorDepth, 30, 40, "...measured also at this depth ahead of the camera [m]");
 }
 
 void SlamConfig::checkKnownKeys(const mrpt::config::CConfigFileBase& c)

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <stdexcept>
 
 namespace keygrid::slam
 {
@@ -34,6 +35,24 @@ std::vector<std::string> StageTimings::stages() const
 	std::lock_guard<std::mutex> lk(m_mutex);
 	std::vector<std::string> out;
 	for (const auto& [k, v] : m_samples) out.push_back(k);
+	return out;
+}
+
+std::vector<double> StageTimings::blockMeans(const std::string& stage, std::size_t block) const
+{
+	if (block == 0) throw std::invalid_argument("StageTimings::blockMeans: block must be >= 1");
+	std::lock_guard<std::mutex> lk(m_mutex);
+	std::vector<double> out;
+	const auto it = m_samples.find(stage);
+	if (it == m_samples.end()) return out;
+	const auto& v = it->second;
+	for (std::size_t b = 0; b < v.size(); b += block)
+	{
+		const std::size_t e = std::min(v.size(), b + block);
+		double sum = 0;
+		for (std::size_t i = b; i < e; i++) sum += v[i];
+		out.push_back(sum / static_cast<double>(e - b));
+	}
 	return out;
 }
 

@@ -1,9 +1,11 @@
 #include <keygrid/maps/ExportFrame.h>
+#include <keygrid/sfm/BundleWindow.h>
+#include <keygrid/slam/FinalRefinement.h>
 #include <keygrid/slam/System.h>
 
 #include <chrono>
 #include <cstdlib>
-#include <future>
+#include <set>
 #include <stdexcept>
 
 namespace keygrid::slam
@@ -322,26 +324,47 @@ void System::finish()
 	joinThreads();
 	if (m_finished || !m_K || m_map.numKeyFrames() == 0) return;
 	m_finished = true;
+	const auto& rc = m_cfg.refinement;
 	const auto t0 = std::chrono::steady_clock::now();
-	if (m_cfg.refinement.globalBundleAdjustment && m_map.numKeyFrames() > 1 && !m_localizeOnly)
+	// Keyframe poses before the refinement (erased keyframes via their parents).
+	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> before;
+	for (const auto& f : m_frames)
+	{
+		mrpt::poses::CPose3D T;
+		if (f.newKeyFrame && m_map.poseOf(f.keyframe, T)) before[f.keyframe] = T;
+	}
+	// Bounded: the keyframes around the closed loops and the newest ones move (see
+	// sfm::growBundleWindow); unbounded (small map or global_max_keyframes = 0): every one.
+	std::optional<std::set<sfm::KeyFrameId>> window;
+	if (rc.globalBundleAdjustment && m_map.numKeyFrames() > 1 && !m_localizeOnly)
 	{
 		auto o = m_cfg.mapping.ba;
-		o.iterations = m_cfg.refinement.globalIterations;
+		o.iterations = rc.globalIterations;
 		// Once per run: to convergence (Ceres' default tolerance), not the local windows' early stop.
 		o.functionTolerance = 1e-6;
-		m_globalBa = sfm::globalBundleAdjustment(m_map, *m_K, o);
+		const auto maxKf = static_cast<std::size_t>(rc.globalMaxKeyFrames);
+		if (maxKf > 0 && m_map.numKeyFrames() > maxKf)
+		{
+			const auto w = sfm::growBundleWindow(m_map, finalWindowSeeds(m_loops, m_map), maxKf);
+			window.emplace(w.local.begin(), w.local.end());
+			m_globalBa = sfm::bundleAdjust(m_map, w.local, w.fixed, *m_K, o);
+		}
+		else
+			m_globalBa = sfm::globalBundleAdjustment(m_map, *m_K, o);
 	}
 	m_timings.add("global_bundle_adjustment", secondsSince(t0));
 	if (m_maps && !m_localizeOnly)
 	{
-		// Re-anchor the maps on the refined keyframe poses (erased keyframes via their parents).
+		// Re-anchor the maps on the refined keyframe poses, unless no keyframe moved enough
+		// to show in them (a grid rebuild costs as much as the whole map).
 		std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> poses;
-		for (const auto& f : m_frames)
+		for (const auto& [id, T0] : before)
 		{
 			mrpt::poses::CPose3D T;
-			if (f.newKeyFrame && m_map.poseOf(f.keyframe, T)) poses[f.keyframe] = T;
+			if (m_map.poseOf(id, T)) poses[id] = T;
 		}
-		for (const auto& [name, sec] : m_maps->applyCorrection(poses)) m_timings.add("map_correction:" + name, sec);
+		if (largestDisplacement(before, poses, rc.mapReanchorDepth) > rc.mapReanchorMinShift)
+			for (const auto& [name, sec] : m_maps->applyCorrection(poses)) m_timings.add("map_correction:" + name, sec);
 		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 	}
 	if (m_recorder)
@@ -360,42 +383,20 @@ void System::finish()
 		}
 		m_timings.add("session_store", secondsSince(t2));
 	}
-	if (!m_cfg.refinement.refineFrames) return;
+	if (!rc.refineFrames) return;
 	const auto t1 = std::chrono::steady_clock::now();
-	const auto base = trajectory();
-	m_refined.assign(m_frames.size(), std::nullopt);
-	// Frames are independent: two workers (every other frame each) read the map and write only
-	// their own m_refined entries, so the result does not depend on scheduling.
 	const sfm::SparseMap& map = m_map;
-	const auto refine = [&](std::size_t first)
-	{
-		for (std::size_t i = first; i < m_frames.size(); i += 2)
+	m_refined = refineFramePoses(
+		m_frames, trajectory(), m_map, *m_K, m_cfg.tracker,
+		[&](const sfm::TrackedFrame& f)
 		{
-			const auto& f = m_frames[i];
-			if (!f.tracked) continue;
 			// A keyframe keeps its pose from the (global) bundle adjustment: that joint estimate
 			// beats a pose-only one against points it helped place (measured in doc/evaluation-history.md).
-			if (f.newKeyFrame && map.hasKeyFrame(f.keyframe)) continue;
-			std::vector<sfm::PoseObservation> obs;
-			for (std::size_t k = 0; k < f.observations.size(); k++)
-			{
-				// A landmark fused into another since the frame matched it: use the survivor.
-				const sfm::Landmark* lm = map.findLandmark(map.resolve(f.observedLandmarks[k]));
-				if (!lm) continue;
-				auto ob = f.observations[k];
-				ob.p_world = lm->p_world;
-				obs.push_back(ob);
-			}
-			if (static_cast<int>(obs.size()) < m_cfg.tracker.minInliers) continue;
-			auto T = base[i].T_world_cam;
-			const auto r = sfm::optimizePose(T, obs, *m_K, m_cfg.tracker.pose);
-			if (r.inliers >= m_cfg.tracker.minInliers) m_refined[i] = T;
-		}
-	};
-	// std::async's future joins in its destructor and passes an exception on through get().
-	auto second = std::async(std::launch::async, refine, std::size_t{1});
-	refine(0);
-	second.get();
+			if (f.newKeyFrame && map.hasKeyFrame(f.keyframe)) return false;
+			// Bounded: only frames whose reference keyframe the refinement moved; the others
+			// follow their reference keyframe (trajectory()).
+			return !window || (f.hasReference && window->count(f.reference) > 0);
+		});
 	m_timings.add("frame_refinement", secondsSince(t1));
 }
 

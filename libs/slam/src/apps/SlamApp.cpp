@@ -8,6 +8,7 @@
 #include <keygrid/slam/Interrupt.h>
 #include <keygrid/slam/LivePreview.h>
 #include <keygrid/slam/LiveRun.h>
+#include <keygrid/slam/ProcessMemory.h>
 #include <keygrid/slam/SceneExport.h>
 #include <keygrid/slam/SimpleMapExport.h>
 #include <keygrid/slam/IniReference.h>
@@ -148,10 +149,12 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	core::ProgressBar bar("keygrid-slam", total, !o.quiet);
 	if (!o.quiet) std::cerr << "keygrid-slam: " << input.describe() << ", " << (live ? "live" : cfg.mode) << " mode\n";
 	const auto tStart = Clock::now();
+	MemorySampler memory(25);  // report.json "rss_mb_by_keyframes"
 	auto report = [&](const sfm::TrackedFrame& tf) {
 		const double el = since(tStart);
 		char extra[128];
 		const auto st = sys.stats();
+		memory.onFrame(sys.numKeyFrames(), st.frames);
 		std::snprintf(extra, sizeof(extra), "%.1f fps, kf %zu, lost %zu%s", st.frames / std::max(el, 1e-9),
 					  sys.numKeyFrames(), st.lost, tf.tracked ? "" : " (LOST)");
 		bar.update(st.frames, extra);
@@ -239,7 +242,12 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	res.interrupted = interruptRequested();
 	if (res.interrupted && !o.quiet)
 		std::cerr << "keygrid-slam: interrupted after " << sys.stats().frames << " frames, writing the outputs\n";
-	sys.finish();
+	{
+		// The final step (global bundle adjustment, map re-anchoring, frame refinement) as one.
+		const auto tFinish = Clock::now();
+		sys.finish();
+		sys.timings().add("finish", since(tFinish));
+	}
 	if (res.error.empty()) res.error = sys.backgroundError();
 	const double wall = since(tStart);
 
@@ -485,6 +493,20 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	std::snprintf(b, sizeof(b), "%.3f", wall);
 	js << "  \"wall_time_s\": " << b << ",\n";
 	js << "  \"timings\": " << sys.timings().toJson(2) << ",\n";
+	{
+		// Memory, and how the per-frame cost evolves along the run (tests/benchmarks/slam/office_loop_memory.sh).
+		std::snprintf(b, sizeof(b), "%.1f", peakResidentMegabytes());
+		js << "  \"max_rss_mb\": " << b << ",\n";
+		js << "  \"rss_mb_by_keyframes\": " << memory.toJson() << ",\n";
+		js << "  \"track_and_map_ms_per_100_frames\": [";
+		const auto blocks = sys.timings().blockMeans("track_and_map", 100);
+		for (std::size_t i = 0; i < blocks.size(); i++)
+		{
+			std::snprintf(b, sizeof(b), "%s%.2f", i ? ", " : "", 1e3 * blocks[i]);
+			js << b;
+		}
+		js << "],\n";
+	}
 	if (errs)
 	{
 		std::snprintf(b, sizeof(b), "%.9g", errs->ate.rmse);

@@ -48,7 +48,9 @@ struct FrameFeatures
 	void visitArea(float u, float v, float r, int minLevel, int maxLevel, Visit&& visit) const;
 
 	int m_cell{16}, m_cols{0}, m_rows{0};
-	std::vector<std::vector<int>> m_grid;
+	/** The grid, compact (keyframes keep it for their lifetime): the keypoints of cell c are
+	 * m_cellItems[m_cellStart[c] .. m_cellStart[c + 1]), in index order; cells row-major. */
+	std::vector<int> m_cellStart, m_cellItems;
 };
 
 /** Distance between two descriptors: Hamming for binary, L2 for float. */

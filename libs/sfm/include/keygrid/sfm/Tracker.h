@@ -26,6 +26,27 @@ enum class TrackingState
 	Lost
 };
 
+/** One inlier observation of a tracked frame, kept for the re-estimation of its pose against the
+ * final map (the landmark's position is read from the map then). A run keeps one list per frame,
+ * so it is stored compactly; the values are exactly those of the PoseObservation it stands for
+ * (pixel and depth come from float features). */
+struct FrameObservation
+{
+	double invSigma{1};  //!< 1 / scaleFactor^level
+	float u{0}, v{0};  //!< undistorted pixel
+	float depth{0};  //!< measured depth [m], 0 = none
+
+	PoseObservation toPoseObservation(const Eigen::Vector3d& p_world) const
+	{
+		PoseObservation o;
+		o.p_world = p_world;
+		o.uv = {u, v};
+		o.depth = depth;
+		o.invSigma = invSigma;
+		return o;
+	}
+};
+
 /** What happened to one frame. */
 struct TrackedFrame
 {
@@ -42,10 +63,9 @@ struct TrackedFrame
 	KeyFrameId reference{0};
 	mrpt::poses::CPose3D T_ref_cam;
 	bool hasReference{false};
-	/** Inlier observations of the frame (landmark ids and measurements; p_world is filled
-	 * when the pose is re-estimated against a refined map). */
+	/** Inlier observations of the frame: landmark ids and measurements, index for index. */
 	std::vector<LandmarkId> observedLandmarks;
-	std::vector<PoseObservation> observations;
+	std::vector<FrameObservation> observations;
 	/** HOC bookkeeping of this frame (zero when [hoc] is disabled). */
 	HocUpdateStats hoc;
 	double hocSeconds{0};  //!< thread CPU time of HOC selection and update [s]

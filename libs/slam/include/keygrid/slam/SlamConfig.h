@@ -30,8 +30,27 @@ struct RefinementOptions
 	 * office_loop needs 46-47, and the former bound of 20 left its loop-closed trajectory at
 	 * 1.44 instead of 1.11 cm (doc/evaluation.md, "Batch"). */
 	int globalIterations{100};
-	/** Re-estimate every frame's pose against the refined map (Default: true) */
+	/** Bound of the final bundle adjustment's cost: in a map with more keyframes than this,
+	 * it moves only this many, grown through the covisibility graph from both ends of every
+	 * closed loop and from the newest keyframe (sfm::growBundleWindow); the keyframes outside
+	 * that also see their landmarks hold them in place, and only the frames whose reference
+	 * keyframe moved are re-estimated. The rest of the map keeps what local bundle
+	 * adjustments and the loops' pose graphs made of it, which is less accurate on a long loop
+	 * than one adjustment of every keyframe (doc/evaluation.md, "Memory and final step on a
+	 * long run"). 0: every keyframe and frame, at a cost that grows faster than the map
+	 * (Default: 0) */
+	int globalMaxKeyFrames{0};
+	/** Re-estimate the frames' poses against the refined map: every frame after a global
+	 * bundle adjustment of every keyframe, the frames whose reference keyframe it moved after a
+	 * bounded one (Default: true) */
 	bool refineFrames{true};
+	/** The maps are re-anchored on the refined keyframe poses only when the refinement moved a
+	 * keyframe's camera centre, or the point map_reanchor_depth ahead of it, by more than this;
+	 * a rebuild of the 2D grid and a morph of the 3D grid cost as much as the whole map.
+	 * 0: whenever a keyframe moved at all (Default: 0 m) */
+	double mapReanchorMinShift{0.0};
+	/** Depth of that point [m]: about the range the maps are filled to (Default: 4 m) */
+	double mapReanchorDepth{4.0};
 };
 
 struct SlamConfig

@@ -27,6 +27,9 @@ class StageTimings
 	};
 	Summary summary(const std::string& stage) const;
 	std::vector<std::string> stages() const;
+	/** Mean of each run of `block` consecutive samples of a stage, in the order they were
+	 * added [s] (a last, shorter run included): how a per-frame cost evolves along a run. */
+	std::vector<double> blockMeans(const std::string& stage, std::size_t block) const;
 	/** JSON object: {"stage": {"count":..,"median_ms":..,"p95_ms":..,"mean_ms":..,"max_ms":..,"total_s":..}, ...} */
 	std::string toJson(int indent = 2) const;
 

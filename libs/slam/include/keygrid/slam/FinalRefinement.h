@@ -1,0 +1,40 @@
+#pragma once
+/** \file FinalRefinement.h
+ * Pieces of the final step of a run (System::finish()): which keyframes a bounded final bundle
+ * adjustment grows from, how far the refinement moved the keyframes (do the maps need
+ * re-anchoring?), and the re-estimation of frame poses against the refined map.
+ */
+#include <keygrid/core/TumTrajectory.h>
+#include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/LoopCloser.h>
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <vector>
+
+namespace keygrid::slam
+{
+/** Seeds of the bounded final bundle adjustment (sfm::growBundleWindow): both ends of every
+ * closed loop, the newest loop first (there the pose graph bent the trajectory and landmarks
+ * were fused), then the newest keyframe (refined by the fewest local windows). */
+std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<LoopClosureEvent>& loops, const sfm::SparseMap& map);
+
+/** Largest displacement [m], over the keyframes of `before` that are in `after`, of the camera
+ * centre or of the point `depth` m ahead of it on the optical axis (what a rotation moves in
+ * the maps). */
+double largestDisplacement(
+	const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& before,
+	const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& after, double depth);
+
+/** Re-estimates the pose of every tracked frame that `select` accepts against the landmarks
+ * now in `map` (each starting from `base`, its pose before), from the inlier observations it
+ * kept; a frame keeps no re-estimate (nullopt) when fewer than minInliers observations remain
+ * or are inliers. Frames are independent: two workers (every other frame each) read the map
+ * and write their own entries, so the result does not depend on scheduling. */
+std::vector<std::optional<mrpt::poses::CPose3D>> refineFramePoses(
+	const std::vector<sfm::TrackedFrame>& frames, const core::Trajectory& base, const sfm::SparseMap& map,
+	const sfm::PinholeIntrinsics& K, const sfm::TrackerOptions& tracker,
+	const std::function<bool(const sfm::TrackedFrame&)>& select);
+
+}  // namespace keygrid::slam

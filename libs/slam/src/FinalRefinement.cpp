@@ -1,0 +1,71 @@
+#include <keygrid/slam/FinalRefinement.h>
+
+#include <algorithm>
+#include <future>
+
+namespace keygrid::slam
+{
+std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<LoopClosureEvent>& loops, const sfm::SparseMap& map)
+{
+	std::vector<sfm::KeyFrameId> seeds;
+	for (auto it = loops.rbegin(); it != loops.rend(); ++it)
+	{
+		seeds.push_back(it->keyframe);
+		seeds.push_back(it->loopKeyFrame);
+	}
+	if (map.numKeyFrames() > 0) seeds.push_back(map.keyframes().rbegin()->first);
+	return seeds;
+}
+
+double largestDisplacement(
+	const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& before,
+	const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& after, double depth)
+{
+	double worst = 0;
+	const mrpt::math::TPoint3D ahead(0, 0, depth);  // optical frame: z forward
+	for (const auto& [id, T0] : before)
+	{
+		const auto it = after.find(id);
+		if (it == after.end()) continue;
+		const auto& T1 = it->second;
+		worst = std::max(worst, (T1.translation() - T0.translation()).norm());
+		worst = std::max(worst, (T1.composePoint(ahead) - T0.composePoint(ahead)).norm());
+	}
+	return worst;
+}
+
+std::vector<std::optional<mrpt::poses::CPose3D>> refineFramePoses(
+	const std::vector<sfm::TrackedFrame>& frames, const core::Trajectory& base, const sfm::SparseMap& map,
+	const sfm::PinholeIntrinsics& K, const sfm::TrackerOptions& tracker,
+	const std::function<bool(const sfm::TrackedFrame&)>& select)
+{
+	std::vector<std::optional<mrpt::poses::CPose3D>> refined(frames.size());
+	const auto refine = [&](std::size_t first)
+	{
+		for (std::size_t i = first; i < frames.size(); i += 2)
+		{
+			const auto& f = frames[i];
+			if (!f.tracked || !select(f)) continue;
+			std::vector<sfm::PoseObservation> obs;
+			obs.reserve(f.observations.size());
+			for (std::size_t k = 0; k < f.observations.size(); k++)
+			{
+				// A landmark fused into another since the frame matched it: use the survivor.
+				const sfm::Landmark* lm = map.findLandmark(map.resolve(f.observedLandmarks[k]));
+				if (!lm) continue;
+				obs.push_back(f.observations[k].toPoseObservation(lm->p_world));
+			}
+			if (static_cast<int>(obs.size()) < tracker.minInliers) continue;
+			auto T = base[i].T_world_cam;
+			const auto r = sfm::optimizePose(T, obs, K, tracker.pose);
+			if (r.inliers >= tracker.minInliers) refined[i] = T;
+		}
+	};
+	// std::async's future joins in its destructor and passes an exception on through get().
+	auto second = std::async(std::launch::async, refine, std::size_t{1});
+	refine(0);
+	second.get();
+	return refined;
+}
+
+}  // namespace keygrid::slam
