@@ -174,10 +174,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 std::optional<double> Tracker::recentShareMedian() const
 {
 	if (m_recentShares.empty()) return std::nullopt;
-	std::vector<double> v(m_recentShares.begin(), m_recentShares.end());
-	auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-	std::nth_element(v.begin(), mid, v.end());
-	return *mid;
+	return medianShare({m_recentShares.begin(), m_recentShares.end()});
 }
 
 double Tracker::stepDuration(double timestamp) const
@@ -254,6 +251,16 @@ void Tracker::onMapCorrected()
 	if (m_lastRelative && m_map.poseOf(m_lastRelative->first, T_world_ref)) m_lastPose = T_world_ref + m_lastRelative->second;
 }
 
+void Tracker::startNewMap()
+{
+	std::uint32_t last = 0;
+	for (const auto& [id, kf] : m_map.keyframes()) last = std::max(last, kf.mapId);
+	m_newMapId = m_map.keyframes().empty() ? 0 : last + 1;
+	m_state = TrackingState::NotInitialized;
+	m_velocity.reset();
+	m_lastRelative.reset();
+}
+
 bool Tracker::initialize(Current& cur, TrackedFrame& out)
 {
 	const int withDepth = static_cast<int>(std::count_if(cur.features.depth.begin(), cur.features.depth.end(), [](float d) { return d > 0; }));
@@ -266,6 +273,7 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	kf.features = cur.features;
 	kf.depth = cur.frame->depth;
 	kf.colour = (cur.frame->colour.empty() ? cur.frame->grey : cur.frame->colour).clone();
+	kf.mapId = m_newMapId;
 	const KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;
 	const auto& f = m_map.keyframe(id).features;
 	for (std::size_t i = 0; i < f.size(); i++)
@@ -552,6 +560,7 @@ KeyFrameId Tracker::createKeyFrame(const Current& cur)
 	kf.colour = (cur.frame->colour.empty() ? cur.frame->grey : cur.frame->colour).clone();
 	kf.parent = m_refKf;
 	kf.hasParent = m_map.hasKeyFrame(m_refKf);
+	kf.mapId = kf.hasParent ? m_map.keyframe(m_refKf).mapId : m_newMapId;
 	const KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;
 	auto& k = m_map.keyframe(id);
 	for (std::size_t i = 0; i < cur.matches.size(); i++)

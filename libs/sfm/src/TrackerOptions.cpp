@@ -110,12 +110,18 @@ void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const st
 	c.write(s, "rolling_shutter_readout", rollingShutterReadout, 34, 40, "first-to-last row exposure time [s]; 0 = global shutter");
 }
 
+double medianShare(std::vector<double> shares)
+{
+	if (shares.empty()) throw std::invalid_argument("medianShare: no shares");
+	auto mid = shares.begin() + static_cast<std::ptrdiff_t>(shares.size() / 2);
+	std::nth_element(shares.begin(), mid, shares.end());
+	return *mid;
+}
+
 double requiredRelocalizationShare(const TrackerOptions& o, std::vector<double> recent)
 {
 	if (o.relocalizationShareFactor <= 0 || recent.empty()) return o.relocalizationMinInlierRatio;
-	auto mid = recent.begin() + static_cast<std::ptrdiff_t>(recent.size() / 2);
-	std::nth_element(recent.begin(), mid, recent.end());
-	return std::min(o.relocalizationMinInlierRatio, o.relocalizationShareFactor * *mid);
+	return std::min(o.relocalizationMinInlierRatio, o.relocalizationShareFactor * medianShare(std::move(recent)));
 }
 
 }  // namespace keygrid::sfm

@@ -1,6 +1,7 @@
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/slam/DataFiles.h>
 #include <keygrid/slam/LoopCloser.h>
+#include <keygrid/slam/SeenThroughCheck.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/CMatrixFixed.h>
 
@@ -51,6 +52,14 @@ void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 	maxCorrectionDeg = c.read_double(s, "max_correction_deg", maxCorrectionDeg);
 	if (!(maxCorrectionBase >= 0 && maxCorrectionRatio >= 0 && maxCorrectionDeg > 0))
 		throw std::invalid_argument("[" + s + "] max_correction_base/_ratio must be >= 0 and max_correction_deg > 0");
+	mergeConsistency = c.read_int(s, "merge_consistency", mergeConsistency);
+	mergeToleranceMetres = c.read_double(s, "merge_tolerance_m", mergeToleranceMetres);
+	mergeToleranceDeg = c.read_double(s, "merge_tolerance_deg", mergeToleranceDeg);
+	mergeMaxSeenThrough = c.read_double(s, "merge_max_seen_through", mergeMaxSeenThrough);
+	if (!(mergeMaxSeenThrough >= 0 && mergeMaxSeenThrough <= 1))
+		throw std::invalid_argument("[" + s + "] merge_max_seen_through = " + std::to_string(mergeMaxSeenThrough) + " (must be in [0, 1])");
+	if (mergeConsistency < 1) throw std::invalid_argument("[" + s + "] merge_consistency = " + std::to_string(mergeConsistency) + " (must be >= 1)");
+	if (!(mergeToleranceMetres > 0 && mergeToleranceDeg > 0)) throw std::invalid_argument("[" + s + "] merge_tolerance_m and merge_tolerance_deg must be > 0");
 	vocabularyOptions.branching = c.read_int(s, "vocabulary_branching", vocabularyOptions.branching);
 	vocabularyOptions.levels = c.read_int(s, "vocabulary_levels", vocabularyOptions.levels);
 	if (trainKeyFrames < 2) throw std::invalid_argument("[" + s + "] train_keyframes = " + std::to_string(trainKeyFrames) + " (must be >= 2)");
@@ -76,6 +85,10 @@ void LoopClosingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, cons
 	c.write(s, "max_correction_base", maxCorrectionBase, 30, 40, "[m] largest loop correction: base +");
 	c.write(s, "max_correction_ratio", maxCorrectionRatio, 30, 40, "... ratio x path between the keyframes");
 	c.write(s, "max_correction_deg", maxCorrectionDeg, 30, 40, "[deg] largest loop rotation correction");
+	c.write(s, "merge_consistency", mergeConsistency, 30, 40, "verified loops agreeing on a map merge");
+	c.write(s, "merge_tolerance_m", mergeToleranceMetres, 30, 40, "[m] how far their alignments may differ");
+	c.write(s, "merge_tolerance_deg", mergeToleranceDeg, 30, 40, "[deg] ... and in rotation");
+	c.write(s, "merge_max_seen_through", mergeMaxSeenThrough, 30, 40, "largest share of landmarks seen through for a merge");
 }
 
 LoopCloser::LoopCloser(
@@ -221,8 +234,56 @@ bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::Pi
 	return true;
 }
 
+bool LoopCloser::mergeConfirmed(
+	sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec)
+{
+	const auto& c = m_map.keyframe(cur);
+	const auto& l = m_map.keyframe(cand);
+	if (c.mapId == l.mapId) return true;
+	// A merge has no estimate to check the loop against (the two frames are unrelated), and
+	// look-alike places (a corridor's repeated texture) pass verification now and then; a
+	// true common place keeps verifying as the camera moves on. Each verified loop implies
+	// where the current map lies in the other's frame: `merge_consistency` of them in a row
+	// must agree.
+	const Eigen::Isometry3d align = toIsometry(l.T_world_cam) * T_cand_cur * toIsometry(c.T_world_cam).inverse();
+	// Free space: neither keyframe may see through the other side's landmarks.
+	std::vector<sfm::KeyFrameId> loopSide = {cand}, curSide = {cur};
+	for (const auto n : m_map.bestCovisibles(cand, 5)) loopSide.push_back(n);
+	for (const auto n : m_map.bestCovisibles(cur, 5)) curSide.push_back(n);
+	auto seen = countSeenThrough(m_map, loopSide, (toIsometry(l.T_world_cam) * T_cand_cur).inverse(), c, K);
+	seen += countSeenThrough(m_map, curSide, toIsometry(l.T_world_cam).inverse() * align, l, K);
+	rec.seenThroughRatio = seen.ratio();
+	if (seen.ratio() > m_opts.mergeMaxSeenThrough)
+	{
+		rec.outcome = "merge_seen_through";
+		return false;
+	}
+	bool agrees = false;
+	if (m_merge && m_merge->currentMap == c.mapId && m_merge->loopMap == l.mapId)
+	{
+		const Eigen::Vector3d at = c.cameraCenter();
+		const double dt = (align * at - m_merge->align * at).norm();
+		const double dr = Eigen::AngleAxisd(align.linear().transpose() * m_merge->align.linear()).angle() * 180.0 / M_PI;
+		agrees = dt <= m_opts.mergeToleranceMetres && dr <= m_opts.mergeToleranceDeg;
+	}
+	if (agrees)
+		m_merge->count++;
+	else
+		m_merge = MergeHypothesis{c.mapId, l.mapId, align, 1};
+	m_merge->align = align;
+	if (m_merge->count < m_opts.mergeConsistency)
+	{
+		rec.outcome = "merge_pending";
+		return false;
+	}
+	m_merge.reset();
+	return true;
+}
+
 bool LoopCloser::plausible(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur) const
 {
+	// A loop between two maps merges them: their frames are unrelated, nothing to compare.
+	if (m_map.keyframe(cur).mapId != m_map.keyframe(cand).mapId) return true;
 	// Path travelled between the two keyframes, along the keyframe sequence.
 	double path = 0;
 	std::optional<Eigen::Vector3d> last;
@@ -243,26 +304,46 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 {
 	// Pose graph: every keyframe; consecutive keyframes and strong covisibility pairs keep
 	// their current relative poses (weight 1), the loop edge brings the measured one.
+	//
+	// A loop between two maps (KeyFrame::mapId) merges them: the current keyframe's map is
+	// first moved rigidly so that the loop measurement holds (its provisional frame may be
+	// anywhere), then optimised with the rest. Odometry edges join consecutive keyframes of
+	// one map only.
+	const std::uint32_t curMap = m_map.keyframe(cur).mapId, loopMap = m_map.keyframe(cand).mapId;
+	const bool merge = curMap != loopMap;
+	const Eigen::Isometry3d align = merge ? toIsometry(m_map.keyframe(cand).T_world_cam) * T_cand_cur * toIsometry(m_map.keyframe(cur).T_world_cam).inverse()
+										  : Eigen::Isometry3d::Identity();
 	loop::PoseGraph g;
-	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> oldPoses;
+	std::map<sfm::KeyFrameId, Eigen::Isometry3d> oldIso, newIso;
 	for (const auto& [id, kf] : m_map.keyframes())
 	{
-		oldPoses[id] = kf.T_world_cam;
-		g.addVertex(id, toIsometry(kf.T_world_cam));
+		oldIso[id] = toIsometry(kf.T_world_cam);
+		g.addVertex(id, kf.mapId == curMap ? align * oldIso[id] : oldIso[id]);
 	}
 	auto rel = [&](sfm::KeyFrameId a, sfm::KeyFrameId b) { return g.pose(a).inverse() * g.pose(b); };
-	std::optional<sfm::KeyFrameId> prev;
+	std::map<std::uint32_t, sfm::KeyFrameId> prevOfMap;
 	for (const auto& [id, kf] : m_map.keyframes())
 	{
-		if (prev) g.addEdge({*prev, id, rel(*prev, id), loop::Matrix6d::Identity(), loop::EdgeKind::Odometry});
+		const auto p = prevOfMap.find(kf.mapId);
+		const bool hasPrev = p != prevOfMap.end();
+		const sfm::KeyFrameId prev = hasPrev ? p->second : 0;
+		if (hasPrev) g.addEdge({prev, id, rel(prev, id), loop::Matrix6d::Identity(), loop::EdgeKind::Odometry});
 		for (const auto& [other, w] : kf.covisibility)
-			if (other < id && w >= m_opts.covisibilityEdgeMinWeight && (!prev || other != *prev))
+			if (other < id && w >= m_opts.covisibilityEdgeMinWeight && (!hasPrev || other != prev))
 				g.addEdge({other, id, rel(other, id), loop::Matrix6d::Identity(), loop::EdgeKind::Covisibility});
-		prev = id;
+		prevOfMap[kf.mapId] = id;
 	}
 	g.addEdge({cand, cur, T_cand_cur, loop::Matrix6d::Identity(), loop::EdgeKind::Loop});
-	// Gauge: keyframe 0 defines the world frame; the loop only bends the rest onto it.
+	// Gauge: the first keyframe defines the world frame; the loop only bends the rest onto
+	// it. A loop inside a map not merged yet keeps that map's first keyframe in place.
 	g.setFixed(m_map.keyframes().begin()->first);
+	if (!merge && m_map.keyframes().begin()->second.mapId != curMap)
+		for (const auto& [id, kf] : m_map.keyframes())
+			if (kf.mapId == curMap)
+			{
+				g.setFixed(id);
+				break;
+			}
 	const auto summary = g.optimize(m_opts.poseGraph);
 
 	LoopClosureEvent ev;
@@ -270,11 +351,11 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 	ev.loopKeyFrame = cand;
 	ev.T_loop_cur = toCPose3D(T_cand_cur);
 	if (!summary.usable) return ev;
-	std::map<sfm::KeyFrameId, Eigen::Isometry3d> oldIso, newIso;
+	ev.mergedMap = merge;
 	for (const auto& c : summary.corrections)
 	{
-		oldIso[c.id] = c.T_world_kf_old;
 		newIso[c.id] = c.T_world_kf_new;
+		if (merge && m_map.keyframe(c.id).mapId == curMap) m_map.keyframe(c.id).mapId = loopMap;
 		m_map.keyframe(c.id).T_world_cam = toCPose3D(c.T_world_kf_new);
 		ev.newPoses[c.id] = m_map.keyframe(c.id).T_world_cam;
 	}
@@ -373,7 +454,7 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 	{
 		rec.verifiedCandidate = *cand;
 		Eigen::Isometry3d T_cand_cur = Eigen::Isometry3d::Identity();
-		if (verify(kf, *cand, K, T_cand_cur, rec))  // else verify() named the outcome
+		if (verify(kf, *cand, K, T_cand_cur, rec) && mergeConfirmed(kf, *cand, T_cand_cur, K, rec))  // else they named the outcome
 			out = closeVerifiedLoop(kf, *cand, T_cand_cur, frameIndex, score, K, rec);
 		if (out) out->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}

@@ -88,6 +88,9 @@ void SessionRecorderOptions::loadFromConfigFile(const mrpt::config::CConfigFileB
 	images = c.read_bool(s, "images", images);
 	snapshotEvery = static_cast<int>(core::readFiniteNumber(c, s, "snapshot_every", snapshotEvery));
 	if (snapshotEvery < 0) throw std::invalid_argument("[" + s + "] snapshot_every = " + std::to_string(snapshotEvery) + " (must be >= 0)");
+	newMapAfterLostFrames = static_cast<int>(core::readFiniteNumber(c, s, "new_map_after_lost_frames", newMapAfterLostFrames));
+	if (newMapAfterLostFrames < 0)
+		throw std::invalid_argument("[" + s + "] new_map_after_lost_frames = " + std::to_string(newMapAfterLostFrames) + " (must be >= 0)");
 	sqlite.loadFromConfigFile(c, s);
 	codec.loadFromConfigFile(c, s);
 }
@@ -96,6 +99,7 @@ void SessionRecorderOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, 
 {
 	c.write(s, "images", images, 30, 40, "store each keyframe's colour and depth images");
 	c.write(s, "snapshot_every", snapshotEvery, 30, 40, "metric-map snapshots every N keyframes (0: at the end only)");
+	c.write(s, "new_map_after_lost_frames", newMapAfterLostFrames, 30, 40, "extend mode: lost frames at the start before a new map begins (0: never)");
 	sqlite.saveToConfigFile(c, s);
 	codec.saveToConfigFile(c, s);
 }
@@ -153,6 +157,7 @@ store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const Lo
 	// Keyframes: new ones whole (with images), moved ones as poses, erased ones by id.
 	for (const auto& [id, kf] : map.keyframes())
 	{
+		if (kf.mapId != 0) continue;  // a map not merged yet has no place in the file's frame
 		auto it = m_keyframes.find(id);
 		if (it == m_keyframes.end())
 		{
@@ -202,6 +207,7 @@ store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const Lo
 	// now) get their keypoint -> landmark association rewritten.
 	for (const auto& [id, lm] : map.landmarks())
 	{
+		if (!lm.observations.empty() && map.keyframe(lm.observations.begin()->first).mapId != 0) continue;
 		const std::uint64_t h = landmarkHash(lm, withCounters);
 		auto it = m_landmarks.find(id);
 		if (it != m_landmarks.end() && it->second.hash == h) continue;
@@ -234,7 +240,7 @@ store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const Lo
 	std::set<sfm::KeyFrameId> fresh;
 	for (const auto& r : u.keyframes) fresh.insert(r.id);
 	for (const auto kf : dirtyAssociations)
-		if (!fresh.count(kf) && map.hasKeyFrame(kf)) u.associations.push_back({kf, map.keyframe(kf).landmarks});
+		if (!fresh.count(kf) && m_keyframes.count(kf) && map.hasKeyFrame(kf)) u.associations.push_back({kf, map.keyframe(kf).landmarks});
 	return job;
 }
 

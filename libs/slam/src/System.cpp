@@ -2,7 +2,9 @@
 #include <keygrid/sfm/BundleWindow.h>
 #include <keygrid/slam/FinalRefinement.h>
 #include <keygrid/slam/System.h>
+#include <keygrid/store/KeyFrameImageCodec.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <set>
@@ -64,6 +66,7 @@ LoadedSession System::loadSession(const store::SessionStore& session, bool local
 	std::lock_guard<std::mutex> lock(m_map.mutex());
 	const auto loaded = loadSparseMap(session, m_map);
 	m_localizeOnly = localizeOnly;
+	m_extending = !localizeOnly;
 	m_tracker.startInLoadedMap();
 	m_tracker.setKeyFrameInsertion(!localizeOnly);
 	// The first relocalization is judged against the share the mapping run's tracking matched.
@@ -79,7 +82,29 @@ LoadedSession System::loadSession(const store::SessionStore& session, bool local
 			m_loopCloser->useVocabulary(*session.loadVocabulary(), "stored in " + session.path());
 		m_loopCloser->indexKeyFrames();
 	}
+	if (m_extending) reintegrateLoadedKeyFrames(session);
 	return loaded;
+}
+
+void System::reintegrateLoadedKeyFrames(const store::SessionStore& session)
+{
+	// The camera path goes on from the stored run's (the 3D grid compares voxels by the path
+	// length at which they were seen): along the keyframes, in the order they were made.
+	std::optional<Eigen::Vector3d> last;
+	for (auto& [id, kf] : m_map.keyframes())
+	{
+		const Eigen::Vector3d c = kf.cameraCenter();
+		if (last) m_travelled += (c - *last).norm();
+		last = c;
+		if (!m_maps) continue;
+		// The images come back for the dense maps and keyframes.simplemap.
+		const auto img = session.loadImages(id);
+		auto& k = m_map.keyframe(id);
+		k.colour = img.colour;
+		if (!img.depthRaw.empty()) k.depth = store::KeyFrameImageCodec::rawToDepth(img.depthRaw, k.features.camera.depthUnits);
+		m_maps->insertKeyFrame(m_map, id, m_travelled);
+	}
+	if (m_maps) m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 }
 
 sfm::FrameFeatures System::extract(const core::Frame& frame) const { return m_extractor.extract(frame); }
@@ -119,6 +144,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		mapKeyFrame(job, nullptr);
 		insertAndCloseLoops(job, &tf);
 	}
+	if (m_extending && !m_startedInStoredMap && !m_startedNewMap) startExtending(tf);
 	tf.mapLandmarks = m_map.numLandmarks();
 	lock.unlock();
 	{
@@ -167,17 +193,57 @@ void System::mapKeyFrame(const KeyFrameJob& job, std::unique_lock<std::mutex>* m
 	m_stats.baDiscarded += rep.baDiscarded ? 1 : 0;
 }
 
+void System::startExtending(const sfm::TrackedFrame& tf)
+{
+	// Map lock held. Relocalized in the stored map: the camera is back in mapped space.
+	if (tf.tracked)
+	{
+		m_startedInStoredMap = true;
+		if (m_maps) m_maps->notifyLoopClosure();
+		return;
+	}
+	const int limit = m_cfg.store.newMapAfterLostFrames;
+	if (limit > 0 && ++m_lostAtStart >= static_cast<std::size_t>(limit))
+	{
+		// The stored map has no place like this: map on in a provisional frame until loop
+		// closing finds a common place and merges the two (LoopCloser).
+		m_tracker.startNewMap();
+		m_startedNewMap = true;
+		m_lastTrackedPose.reset();
+	}
+}
+
 void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 {
 	if (!m_map.hasKeyFrame(job.keyframe)) return;  // culled by local mapping
 	if (m_maps)
 	{
 		const auto t0 = std::chrono::steady_clock::now();
-		m_maps->insertKeyFrame(m_map, job.keyframe, job.travelled);
+		// A keyframe of a map not merged yet waits: its pose is in a provisional frame.
+		if (m_map.keyframe(job.keyframe).mapId != 0)
+			m_waitingForMerge.push_back(job);
+		else
+			m_maps->insertKeyFrame(m_map, job.keyframe, job.travelled);
 		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 		m_timings.add("map_insertion", secondsSince(t0));
 	}
 	const auto ev = closeLoops(job, tf);
+	if (ev && ev->mergedMap && m_maps)
+	{
+		const auto t0 = std::chrono::steady_clock::now();
+		for (const auto& w : m_waitingForMerge)
+			if (m_map.hasKeyFrame(w.keyframe) && m_map.keyframe(w.keyframe).mapId == 0) m_maps->insertKeyFrame(m_map, w.keyframe, w.travelled);
+		m_waitingForMerge.erase(
+			std::remove_if(m_waitingForMerge.begin(), m_waitingForMerge.end(), [&](const KeyFrameJob& w) { return !m_map.hasKeyFrame(w.keyframe) || m_map.keyframe(w.keyframe).mapId == 0; }),
+			m_waitingForMerge.end());
+		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+		m_timings.add("map_insertion", secondsSince(t0));
+	}
+	if (ev && ev->mergedMap)
+	{
+		std::lock_guard<std::mutex> lk(m_statsMutex);
+		m_stats.mapsMerged++;
+	}
 	if (m_recorder)
 	{
 		const auto t0 = std::chrono::steady_clock::now();
@@ -328,6 +394,7 @@ void System::finish()
 	const auto t0 = std::chrono::steady_clock::now();
 	// Keyframe poses before the refinement (erased keyframes via their parents).
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> before;
+	for (const auto& [id, kf] : m_map.keyframes()) before[id] = kf.T_world_cam;  // also a loaded map's
 	for (const auto& f : m_frames)
 	{
 		mrpt::poses::CPose3D T;

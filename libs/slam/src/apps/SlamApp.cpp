@@ -128,20 +128,24 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	if (!o.groundTruth.empty()) gt = core::readTumTrajectory(o.groundTruth);
 
 	System sys(cfg);
+	if (!o.localize)
+	{
+		// Localization adds no keyframes: no map is fed. Extend mode re-integrates the stored
+		// keyframes into them when the session is loaded.
+		auto maps = std::make_unique<MetricMaps>(ini, cfg.maps, cfg.floor);
+		if (!maps->empty()) sys.attachMaps(std::move(maps));
+	}
 	std::optional<LoadedSession> loaded;
 	if (!o.loadMap.empty())
 	{
-		const auto session = store::SessionStore::Open(o.loadMap, store::SessionStore::Mode::ReadOnly, cfg.store.sqlite);
+		auto session = store::SessionStore::Open(
+			o.loadMap, o.localize ? store::SessionStore::Mode::ReadOnly : store::SessionStore::Mode::ReadWrite, cfg.store.sqlite);
 		loaded = sys.loadSession(session, o.localize);
 		if (!o.quiet)
 			std::cerr << "keygrid-slam: loaded " << o.loadMap << ": " << loaded->keyframes << " keyframes, " << loaded->landmarks
-					  << " landmarks (" << loaded->seconds << " s)" << (o.localize ? ", localization only" : "") << "\n";
-	}
-	if (!sys.localizeOnly())
-	{
-		// Localization adds no keyframes: no map is fed.
-		auto maps = std::make_unique<MetricMaps>(ini, cfg.maps, cfg.floor);
-		if (!maps->empty()) sys.attachMaps(std::move(maps));
+					  << " landmarks (" << loaded->seconds << " s)" << (o.localize ? ", localization only" : ", extending it") << "\n";
+		// Extend mode: the run's changes go into the same file.
+		if (!o.localize) sys.attachRecorder(std::make_unique<SessionRecorder>(std::move(session), sys.map(), cfg.store));
 	}
 	if (!o.mapFile.empty()) sys.attachRecorder(std::make_unique<SessionRecorder>(o.mapFile, cfg.store));
 	SlamRunResult res;
@@ -252,6 +256,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	const double wall = since(tStart);
 
 	auto traj = sys.trajectory();
+	std::string trajectoryTitle = "keygrid-slam trajectory, every frame";
 	if (sys.localizeOnly())
 	{
 		// A frame not localized has no pose in the map: only the localized ones are listed.
@@ -260,8 +265,22 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			if (sys.frames()[i].tracked) localized.push_back(traj[i]);
 		traj = std::move(localized);
 		res.localized = traj.size();
+		trajectoryTitle = "keygrid-slam trajectory in the loaded map's frame, every localized frame";
 	}
-	writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, sys.localizeOnly() ? "keygrid-slam trajectory in the loaded map's frame, every localized frame" : "keygrid-slam trajectory, every frame"));
+	else if (loaded)
+	{
+		// Extend mode: the frames before the camera found its place (in the stored map or in a
+		// new one) have no pose.
+		std::size_t first = 0;
+		while (first < sys.frames().size() && !sys.frames()[first].tracked) first++;
+		traj.erase(traj.begin(), traj.begin() + static_cast<std::ptrdiff_t>(std::min(first, traj.size())));
+		trajectoryTitle = "keygrid-slam trajectory in the loaded map's frame, every frame from the first tracked one";
+		const auto ex = sys.extendState();
+		if (ex.waitingForMerge > 0 && !o.quiet)
+			std::cerr << "keygrid-slam: warning: the new map never met the stored one; its " << ex.waitingForMerge
+					  << " keyframes are in a frame of their own, not in the metric maps nor in " << o.loadMap << "\n";
+	}
+	writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, trajectoryTitle));
 	// The run's floor frame (any map configured): every map output is written in it.
 	const std::optional<mrpt::poses::CPose3D> T_world_floor =
 		sys.metricMaps() ? sys.metricMaps()->T_world_floor() : std::nullopt;
@@ -318,15 +337,15 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	{
 		// Why each keyframe did or did not close a loop (doc/loop-closure.md, "Diagnostics").
 		std::ostringstream csv;
-		csv << "keyframe,frame,outcome,reference_score,candidates,best_candidate,best_score,verified_candidate,matches,inliers,query_ms\n";
+		csv << "keyframe,frame,outcome,reference_score,candidates,best_candidate,best_score,verified_candidate,matches,inliers,query_ms,seen_through\n";
 		for (const auto& q : sys.loopCloser()->queries())
 		{
 			char line[256];
-			std::snprintf(line, sizeof(line), "%llu,%zu,%s,%.4f,%d,%s,%.4f,%s,%d,%d,%.3f\n", static_cast<unsigned long long>(q.keyframe),
+			std::snprintf(line, sizeof(line), "%llu,%zu,%s,%.4f,%d,%s,%.4f,%s,%d,%d,%.3f,%.4f\n", static_cast<unsigned long long>(q.keyframe),
 						  q.frameIndex, q.outcome.c_str(), q.referenceScore, q.candidates,
 						  q.candidates ? std::to_string(q.bestCandidate).c_str() : "", q.bestScore,
 						  q.verifiedCandidate ? std::to_string(*q.verifiedCandidate).c_str() : "", q.matches, q.inliers,
-						  1e3 * q.querySeconds);
+						  1e3 * q.querySeconds, q.seenThroughRatio);
 			csv << line;
 		}
 		try
@@ -445,15 +464,24 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		js << l;
 	}
 	js << "],\n";
+	// One "session" object: what was loaded, what was recorded, or both (extend mode).
 	if (loaded)
 	{
 		char l[400];
 		std::snprintf(l, sizeof(l),
 					  "  \"session\": {\"loaded\": \"%s\", \"mode\": \"%s\", \"keyframes\": %zu, \"landmarks\": %zu, \"load_s\": %.3f, "
-					  "\"localized\": %zu, \"lost\": %zu, \"localized_ratio\": %.4f},\n",
+					  "\"localized\": %zu, \"lost\": %zu, \"localized_ratio\": %.4f",
 					  jsonEscape(o.loadMap).c_str(), o.localize ? "localize" : "extend", loaded->keyframes, loaded->landmarks, loaded->seconds,
 					  st.tracked, st.lost, st.frames ? static_cast<double>(st.tracked) / static_cast<double>(st.frames) : 0.0);
 		js << l;
+		if (!o.localize)
+		{
+			const auto ex = sys.extendState();
+			std::snprintf(l, sizeof(l), ", \"started\": \"%s\", \"maps_merged\": %zu, \"keyframes_waiting_for_merge\": %zu",
+						  ex.startedInStoredMap ? "in_stored_map" : ex.startedNewMap ? "new_map" : "never", st.mapsMerged, ex.waitingForMerge);
+			js << l;
+		}
+		js << (sys.recorder() ? ",\n    " : "},\n");
 	}
 	if (const SessionRecorder* rec = sys.recorder())
 	{
@@ -463,9 +491,9 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		const auto bytes = std::filesystem::file_size(rec->path(), ec);
 		char l[512];
 		std::snprintf(l, sizeof(l),
-					  "  \"session\": {\"recorded\": \"%s\", \"updates\": %zu, \"keyframes_written\": %zu, \"landmarks_written\": %zu, "
+					  "%s\"recorded\": \"%s\", \"updates\": %zu, \"keyframes_written\": %zu, \"landmarks_written\": %zu, "
 					  "\"snapshots\": %zu, \"build_ms_per_update\": %.3f, \"writer_encode_s\": %.3f, \"writer_commit_s\": %.3f, \"file_mb\": %.3f},\n",
-					  jsonEscape(rec->path()).c_str(), rs.updates, rs.keyframesWritten, rs.landmarksWritten, rs.snapshots,
+					  loaded ? "" : "  \"session\": {", jsonEscape(rec->path()).c_str(), rs.updates, rs.keyframesWritten, rs.landmarksWritten, rs.snapshots,
 					  rs.updates ? 1e3 * rs.buildSeconds / static_cast<double>(rs.updates) : 0.0, ws.encodeSeconds, ws.writeSeconds,
 					  ec ? 0.0 : static_cast<double>(bytes) / (1024.0 * 1024.0));
 		js << l;
@@ -545,7 +573,7 @@ int SlamApp::run(int argc, const char* const* argv)
 			.option("max-frames", "N", "stop after N frames", false, "0 (all)")
 			.option("first-frame", "N", "skip the first N input frames", false, "0")
 			.option("map", "FILE", "record the run into a new session file (keyframes, landmarks, images, map snapshots; doc/session-store.md)")
-			.option("load-map", "FILE", "start from a stored session (with --localize)")
+			.option("load-map", "FILE", "start from a stored session: extend it (the run is recorded into FILE), or with --localize track in it")
 			.flag("localize", "with --load-map: track in the stored map without adding to it; FILE is not changed")
 			.option(
 				"set", "SECTION.KEY=V[;...]",
@@ -616,10 +644,11 @@ int SlamApp::run(int argc, const char* const* argv)
 		if (cl.has("load-map")) o.loadMap = cl.get("load-map");
 		o.localize = cl.flagSet("localize");
 		if (o.localize && o.loadMap.empty()) throw core::CommandLineError("--localize needs --load-map FILE");
-		if (!o.loadMap.empty() && !o.localize)
-			throw core::CommandLineError("--load-map needs --localize (continuing a stored map is not supported yet)");
 		if (live && o.firstFrame) throw core::CommandLineError("--first-frame is for recorded inputs, not --live");
-		if (!o.loadMap.empty() && !o.mapFile.empty()) throw core::CommandLineError("--map and --load-map --localize exclude each other (localization does not record)");
+		if (!o.loadMap.empty() && !o.mapFile.empty())
+			throw core::CommandLineError(
+				o.localize ? "--map and --load-map --localize exclude each other (localization does not record)"
+						   : "--map and --load-map exclude each other (--load-map FILE without --localize records into FILE itself)");
 		o.quiet = cl.flagSet("quiet");
 		o.live = live;
 		o.preview = live && !cl.flagSet("no-preview") && (cl.flagSet("preview") || LivePreview::displayAvailable());

@@ -62,6 +62,11 @@ struct KeyFrame
 	/** Keyframe that was the reference when this one was created (spanning tree parent). */
 	KeyFrameId parent{0};
 	bool hasParent{false};
+	/** Which map the keyframe belongs to: 0, the map anchored in the world frame; a map
+	 * started where the loaded one had no place to relocalize (extend mode) gets a new id and
+	 * its own provisional frame until a loop merges it into map 0 (LoopCloser). Keyframes of
+	 * different maps share no landmarks. */
+	std::uint32_t mapId{0};
 
 	Eigen::Vector3d cameraCenter() const;
 	int trackedLandmarks(int minObservations = 1, const class SparseMap* map = nullptr) const;

@@ -103,6 +103,10 @@ class Tracker
 	/** The map was loaded (a stored session): the next frame relocalizes in it (vocabulary
 	 * tree, then the newest keyframes) instead of starting a new map. */
 	void startInLoadedMap() { m_state = TrackingState::Lost; }
+	/** Gives up relocalizing in the loaded map: the next frame starts a new map (a new
+	 * KeyFrame::mapId, at the identity pose of a provisional frame) that loop closing merges
+	 * into the loaded one when it finds a common place. */
+	void startNewMap();
 	/** false: localization only, no keyframe is created (the map stays as loaded apart from
 	 * the landmarks' visibility counters and HOC histograms). (Default: true) */
 	void setKeyFrameInsertion(bool on) { m_insertKeyFrames = on; }
@@ -200,6 +204,7 @@ class Tracker
 	std::function<bool()> m_mappingBusy;  //!< see deferKeyFramesWhile (empty: never deferred)
 	double m_deferWeakRatio{0};  //!< set with m_mappingBusy
 	bool m_insertKeyFrames{true};  //!< see setKeyFrameInsertion
+	std::uint32_t m_newMapId{0};  //!< KeyFrame::mapId of the map initialize() starts
 	bool m_relocRecognized{false};  //!< the last relocalize() succeeded on a recognized place
 	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
 };

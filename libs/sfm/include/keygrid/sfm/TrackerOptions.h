@@ -103,5 +103,8 @@ struct TrackerOptions
  * o.relocalizationShareFactor x the median of `recentShares`), the shares matched by recently
  * tracked frames (the fixed ratio when the factor is 0 or there are none). */
 double requiredRelocalizationShare(const TrackerOptions& o, std::vector<double> recentShares);
+/** The median of tracked frames' shares of the local map (the upper one of an even count);
+ * throws std::invalid_argument when empty. */
+double medianShare(std::vector<double> shares);
 
 }  // namespace keygrid::sfm

@@ -45,6 +45,14 @@ struct LoopClosingOptions
 	 * [m], and rotate it by at most max_correction_deg. Drift is a small fraction of the path;
 	 * larger "corrections" come from look-alike places (Default: 0.1 m, 0.1, 10 deg) */
 	double maxCorrectionBase{0.1}, maxCorrectionRatio{0.1}, maxCorrectionDeg{10.0};
+	/** A loop between two maps (extend mode: a map started apart from the loaded one) merges
+	 * them; this many verified loops in a row must place the current map alike, within
+	 * merge_tolerance_m and merge_tolerance_deg (Default: 3, 0.05 m, 2 deg) */
+	int mergeConsistency{3};
+	double mergeToleranceMetres{0.05}, mergeToleranceDeg{2.0};
+	/** Each of those loops: of the landmarks of either side that the other keyframe measures
+	 * (SeenThroughCheck.h), at most this share may be seen through (Default: 0.01) */
+	double mergeMaxSeenThrough{0.01};
 	/** Covisibility edges of the pose graph need this many shared landmarks (Default: 100) */
 	int covisibilityEdgeMinWeight{100};
 	loop::PoseGraphOptions poseGraph;
@@ -67,6 +75,9 @@ struct LoopClosureEvent
 	double score{0};
 	int inliers{0};
 	double correctionMetres{0};  //!< how far the current keyframe moved
+	/** The loop joined two maps (KeyFrame::mapId): the current keyframe's map was moved into
+	 * the loop keyframe's and now has its id. */
+	bool mergedMap{false};
 	double seconds{0};
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> newPoses;
 };
@@ -81,7 +92,9 @@ struct LoopQueryRecord
 	 * (detection paused right after a loop), "no_candidate" (nothing above the covisible
 	 * keyframes' score), "not_consistent" (no candidate group seen in enough consecutive
 	 * keyframes), "few_matches" / "ransac_failed" (geometric verification), "implausible"
-	 * (correction larger than drift explains), "pose_graph_failed" */
+	 * (correction larger than drift explains), "merge_pending" (a loop between two maps waiting
+	 * for more that agree, see mergeConsistency), "merge_seen_through" (a loop between two
+	 * maps that puts landmarks where a keyframe sees free space), "pose_graph_failed" */
 	std::string outcome;
 	/** The lowest BoW score between the keyframe and its covisible keyframes */
 	double referenceScore{0};
@@ -93,6 +106,8 @@ struct LoopQueryRecord
 	/** Verification: descriptor matches with depth on both sides, RANSAC inliers */
 	int matches{0}, inliers{0};
 	double querySeconds{0};  //!< BoW transform + database query [s]
+	/** A loop between two maps: the share of landmarks seen through (SeenThroughCheck.h) */
+	double seenThroughRatio{0};
 };
 
 class LoopCloser
@@ -135,6 +150,11 @@ class LoopCloser
 	void trainIfReady();
 	/** The consistent candidate, if any; fills rec's candidate fields. */
 	std::optional<sfm::KeyFrameId> detect(sfm::KeyFrameId kf, const loop::BowVector& bow, double& score, LoopQueryRecord& rec);
+	/** True for a loop inside one map; for one between two maps (a merge), true once
+	 * mergeConsistency verified loops in a row agree on where the current map lies (else
+	 * rec.outcome = "merge_pending"). */
+	bool mergeConfirmed(
+		sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec);
 	/** False when the loop measurement disagrees with the estimate more than drift can explain. */
 	bool plausible(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur) const;
 	bool verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, LoopQueryRecord& rec);
@@ -155,6 +175,14 @@ class LoopCloser
 	std::set<sfm::KeyFrameId> m_dbIds;
 	loop::ConsistencyChecker m_consistency;
 	std::optional<loop::PoseGraph> m_lastGraph;
+	/** Verified loops between two maps so far, agreeing on align = T_loopMap_currentMap. */
+	struct MergeHypothesis
+	{
+		std::uint32_t currentMap{0}, loopMap{0};
+		Eigen::Isometry3d align{Eigen::Isometry3d::Identity()};
+		int count{0};
+	};
+	std::optional<MergeHypothesis> m_merge;
 	sfm::KeyFrameId m_lastLoopKf{0};
 	bool m_anyLoop{false};
 	std::vector<LoopQueryRecord> m_queries;

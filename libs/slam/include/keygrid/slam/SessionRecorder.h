@@ -39,6 +39,10 @@ struct SessionRecorderOptions
 	/** Snapshot of the metric maps every this many keyframes, and always at the end; 0 = at
 	 * the end only (Default: 25) */
 	int snapshotEvery{25};
+	/** Extend mode (--load-map without --localize): frames the camera may stay lost at the
+	 * start before a new map is begun, apart from the stored one and merged into it by the
+	 * first loop closed between the two; 0 = keep relocalizing (Default: 15) */
+	int newMapAfterLostFrames{15};
 	/** SQLite durability, cache, lock timeout, integrity check on open */
 	store::SessionStoreOptions sqlite;
 	/** Compression of the keyframe images */
@@ -64,7 +68,8 @@ class SessionRecorder
 	 * file appears with the first keyframe, whose camera becomes the session's camera. */
 	SessionRecorder(const std::string& path, const SessionRecorderOptions& opts);
 	/** Continues a stored session (extend mode): `store` open for writing, the map loaded from
-	 * it; only what changes from now on is written. */
+	 * it; only what changes from now on is written. Keyframes of a map not merged into the
+	 * stored one (KeyFrame::mapId != 0) and their landmarks are written once it is. */
 	SessionRecorder(store::SessionStore store, const sfm::SparseMap& loaded, const SessionRecorderOptions& opts);
 	~SessionRecorder();
 

@@ -48,6 +48,8 @@ struct SystemStats
 	/** Threaded mode: local bundle adjustments dropped because a loop closure moved the map
 	 * while they were solved. */
 	std::size_t baDiscarded{0};
+	/** Extend mode: a map started apart from the loaded one merged into it by loop closing. */
+	std::size_t mapsMerged{0};
 };
 
 class System
@@ -84,11 +86,25 @@ class System
 	const SessionRecorder* recorder() const { return m_recorder.get(); }
 	/** Loads a stored session's map before the first frame; the first frame relocalizes in it.
 	 * `localizeOnly`: no keyframes are added, the map is not refined at the end (finish() only
-	 * re-estimates the frames). The loop closer, when enabled, takes the session's stored
+	 * re-estimates the frames). Otherwise (extend mode; attach the maps first) the stored
+	 * keyframes are re-integrated into the metric maps, and when the first [store]
+	 * new_map_after_lost_frames frames do not relocalize a new map is started (see
+	 * extendState()). The loop closer, when enabled, takes the session's stored
 	 * vocabulary if its own is to be trained in the run, and indexes the loaded keyframes for
 	 * relocalization. Throws std::logic_error after the first frame. */
 	LoadedSession loadSession(const store::SessionStore& session, bool localizeOnly);
 	bool localizeOnly() const { return m_localizeOnly; }
+	/** Extend mode (a session loaded without localizeOnly): how the run entered the stored
+	 * map. `startedNewMap`: the first [store] new_map_after_lost_frames frames did not
+	 * relocalize, so a new map was started (merged when SystemStats::mapsMerged > 0);
+	 * `waitingForMerge`: its keyframes not in the metric maps (nor the session file) because
+	 * it was never merged. */
+	struct ExtendState
+	{
+		bool startedInStoredMap{false}, startedNewMap{false};
+		std::size_t waitingForMerge{0};
+	};
+	ExtendState extendState() const { return {m_startedInStoredMap, m_startedNewMap, m_waitingForMerge.size()}; }
 
 	/** After the last frame: waits for the mapping and loop-closing threads to process every
 	 * queued keyframe, then global bundle adjustment and frame re-estimation, as configured in
@@ -136,6 +152,12 @@ class System
 	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
 	 * tracker's last frame, which created the keyframe. */
 	void insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
+	/** Extend mode, the stored map loaded: its keyframes into the metric maps (images from the
+	 * session file), and the camera path length it ends with. */
+	void reintegrateLoadedKeyFrames(const store::SessionStore& session);
+	/** Extend mode, until the camera relocalized in the stored map or a new map was started
+	 * (map lock held). */
+	void startExtending(const sfm::TrackedFrame& tf);
 	/** Hands the recorder what a later localization in the session needs from this run. */
 	void noteRunAttributes();
 	/** Loop detection and correction of a keyframe (map lock held); the event when one closed. */
@@ -162,6 +184,11 @@ class System
 	std::unique_ptr<MetricMaps> m_maps;
 	std::unique_ptr<SessionRecorder> m_recorder;
 	bool m_localizeOnly{false};
+	// Extend mode (see ExtendState).
+	bool m_extending{false}, m_startedInStoredMap{false}, m_startedNewMap{false};
+	std::size_t m_lostAtStart{0};
+	/** Keyframes of a map not merged yet, for the metric maps once it is. */
+	std::vector<KeyFrameJob> m_waitingForMerge;
 	std::unique_ptr<LoopCloser> m_loopCloser;
 	std::vector<LoopClosureEvent> m_loops;
 	std::optional<sfm::BundleAdjusterReport> m_globalBa;
