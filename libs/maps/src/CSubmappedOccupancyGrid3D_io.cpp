@@ -301,12 +301,21 @@ void CSubmappedOccupancyGrid3D::saveAsOctomapBinary(const std::string& path, con
 			"saveAsOctomapBinary: " + std::to_string(outside) +
 			" voxels lie outside the OcTree key range (+-32768 voxels)");
 	tree.updateInnerOccupancy();
-	// OctoMap's header: a first line it checks, then keyword lines; it skips lines starting
-	// with '#' (AbstractOcTree::readHeader), so the frame goes in as the second line.
+	// What AbstractOccupancyOcTree::writeBinary writes, which then prints " done." on stderr
+	// (noise in a quiet run): the tree at maximum likelihood, pruned, after OctoMap's header: a
+	// first line OctoMap checks, then
+	// keyword lines; it skips lines starting with '#' (AbstractOcTree::readHeader), so the
+	// frame goes in as the second line.
+	tree.toMaxLikelihood();
+	tree.prune();
 	std::ostringstream bt;
-	if (!tree.writeBinary(bt)) throw std::runtime_error("saveAsOctomapBinary: cannot serialize the tree");
-	std::string data = bt.str();
-	if (!frame.comment.empty()) data.insert(data.find('\n') + 1, "# " + frame.comment + "\n");
+	bt << "# Octomap OcTree binary file\n";
+	if (!frame.comment.empty()) bt << "# " << frame.comment << "\n";
+	bt << "# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
+	   << "id " << tree.getTreeType() << "\nsize " << tree.size() << "\nres " << tree.getResolution() << "\ndata\n";
+	tree.writeBinaryData(bt);
+	if (!bt) throw std::runtime_error("saveAsOctomapBinary: cannot serialize the tree");
+	const std::string data = bt.str();
 	std::ofstream f(path, std::ios::binary);
 	f.write(data.data(), static_cast<std::streamsize>(data.size()));
 	if (!f) throw std::runtime_error("saveAsOctomapBinary: cannot write '" + path + "'");
