@@ -4,7 +4,9 @@
 #include "Grid3DTestScenes.h"
 
 #include <gtest/gtest.h>
+#include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <keygrid/maps/DepthFrameIntegrator.h>
+#include <mrpt/config/CConfigFileMemory.h>
 
 #include <set>
 
@@ -172,4 +174,33 @@ TEST(SubmappedIntegration, OptionsValidateAndRoundTrip)
 		EXPECT_NE(std::string(e.what()).find("maxRange"), std::string::npos) << e.what();
 	}
 	EXPECT_THROW(DepthFrameIntegrator{o}, std::invalid_argument);
+	// Memory bounds: a dense mark volume beyond 2^30 one-byte voxels is refused.
+	DepthIntegrationOptions big;
+	big.maxDenseMarkVoxels = 1e30;
+	EXPECT_THROW(big.validate(), std::invalid_argument);
+	big.maxDenseMarkVoxels = 1073741824.0;
+	EXPECT_NO_THROW(big.validate());
+}
+
+TEST(SubmappedIntegration, ResolutionOutsideItsRangeIsRefusedNamingTheKey)
+{
+	// 1e-9 m voxels filled 8 GB in under a minute; 1e30 m is no map.
+	for (const double r : {1e-9, 0.001, 0.0049, 10.5, 1e30, -0.05})
+	{
+		EXPECT_THROW(CSubmappedOccupancyGrid3D{r}, std::invalid_argument) << r;
+		mrpt::config::CConfigFileMemory ini;
+		ini.write("m_creationOpts", "resolution", std::to_string(r));
+		CSubmappedOccupancyGrid3D::TMapDefinition def;
+		try
+		{
+			def.loadFromConfigFile(ini, "m");
+			ADD_FAILURE() << "resolution " << r << " accepted";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find("m_creationOpts/resolution"), std::string::npos) << e.what();
+		}
+	}
+	for (const double r : {CSubmappedOccupancyGrid3D::kMinResolution, 0.05, CSubmappedOccupancyGrid3D::kMaxResolution})
+		EXPECT_NO_THROW(CSubmappedOccupancyGrid3D{r}) << r;
 }

@@ -29,7 +29,8 @@ void CSubmappedOccupancyGrid3D::TMapDefinition::loadFromConfigFile_map_specific(
 {
 	const std::string sCreation = prefix + "_creationOpts";
 	resolution = detail::readNumber(source, sCreation, "resolution", resolution);
-	detail::require(resolution > 0, sCreation + "/resolution", resolution, "> 0 m");
+	detail::require(resolution >= kMinResolution && resolution <= kMaxResolution, sCreation + "/resolution", resolution,
+		"in [" + std::to_string(kMinResolution) + ", " + std::to_string(kMaxResolution) + "] m");
 	insertionOpts.loadFromConfigFile(source, prefix + "_insertOpts");
 	morphingOpts.loadFromConfigFile(source, prefix + "_insertOpts");
 	likelihoodOpts.loadFromConfigFile(source, prefix + "_likelihoodOpts");
@@ -103,7 +104,8 @@ CSubmappedOccupancyGrid3D::CSubmappedOccupancyGrid3D(double resolution)
 
 void CSubmappedOccupancyGrid3D::setResolution(double resolution)
 {
-	detail::require(resolution > 0 && std::isfinite(resolution), "resolution", resolution, "> 0 m");
+	detail::require(resolution >= kMinResolution && resolution <= kMaxResolution, "resolution", resolution,
+		"in [" + std::to_string(kMinResolution) + ", " + std::to_string(kMaxResolution) + "] m");
 	m_resolution = resolution;
 	internal_clear();
 }

@@ -65,7 +65,8 @@ void DepthIntegrationOptions::validate() const
 	require(logOddsMiss < 0, "logOddsMiss", logOddsMiss, "< 0");
 	require(logOddsMin < 0, "logOddsMin", logOddsMin, "< 0");
 	require(logOddsMax > 0, "logOddsMax", logOddsMax, "> 0");
-	require(maxDenseMarkVoxels >= 512, "maxDenseMarkVoxels", maxDenseMarkVoxels, ">= 512");
+	require(maxDenseMarkVoxels >= 512 && maxDenseMarkVoxels <= 1073741824.0, "maxDenseMarkVoxels", maxDenseMarkVoxels,
+		"in [512, 1073741824] (one byte per voxel)");
 }
 
 // ---------------------------------------------------------------- ray table

@@ -119,7 +119,13 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap
 	MorphingOptions morphingOptions;
 	TLikelihoodOptions likelihoodOptions;
 
-	/** \param resolution Voxel edge [m] (Default: 0.05 m). */
+	/** Voxel edges accepted [m]: finer than any RGB-D camera's depth step at 1 m is only
+	 * memory and time (a ray of maxRange crosses maxRange / resolution voxels); coarser than
+	 * a room is no map. */
+	static constexpr double kMinResolution = 0.005, kMaxResolution = 10.0;
+
+	/** \param resolution Voxel edge [m] in [kMinResolution, kMaxResolution] (Default: 0.05 m);
+	 * std::invalid_argument otherwise. */
 	explicit CSubmappedOccupancyGrid3D(double resolution = 0.05);
 
 	double resolution() const { return m_resolution; }

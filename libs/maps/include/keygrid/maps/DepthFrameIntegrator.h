@@ -61,8 +61,9 @@ struct DepthIntegrationOptions
 	 * less ray casting; the carved free space differs from per-pixel rays only at the rim of
 	 * thin rays between neighbouring end voxels (Default: true) */
 	bool discretizeEndpoints{true};
-	/** Largest dense per-frame mark volume [voxels, 1 byte each]; frames whose bounding box is
-	 * larger use a slower sparse path (Default: 64 Mi voxels = 64 MB) */
+	/** Largest dense per-frame mark volume [voxels, 1 byte each], in [512, 2^30] (memory);
+	 * frames whose bounding box is larger use a slower sparse path (Default: 64 Mi voxels =
+	 * 64 MB) */
 	double maxDenseMarkVoxels{64.0 * 1024 * 1024};
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
