@@ -129,6 +129,21 @@ TEST(SlamApp, BadInputsAreClearErrors)
 	EXPECT_NE(out.find("mapping_lag = 9"), std::string::npos) << out;
 	EXPECT_EQ(test::runCommand(tool + " --config " + test::sourceDir() + "/config/tum_fr1.ini --input /nonexistent --output " + dir, &out), 1);
 	EXPECT_NE(out.find("/nonexistent"), std::string::npos) << out;
+	// A folder where a file belongs, values that are not what the key takes: named before any
+	// frame is read.
+	EXPECT_EQ(test::runCommand(tool + " --config " + dir + " --input x --output " + dir, &out), 1);
+	EXPECT_NE(out.find("is a folder, not a file"), std::string::npos) << out;
+	const std::string fr1 = " --config " + test::sourceDir() + "/config/tum_fr1.ini --input /nonexistent --output " + dir;
+	EXPECT_EQ(test::runCommand(tool + fr1 + " --gt " + dir, &out), 1);
+	EXPECT_NE(out.find("is a folder, not a file"), std::string::npos) << out;
+	for (const char* v : {"99999999999", "1000abc", "1e3", "40.0.0", "forty"})
+	{
+		EXPECT_EQ(test::runCommand(tool + fr1 + " --set features.num_features=" + v, &out), 1) << v;
+		EXPECT_NE(out.find(std::string("num_features = ")), std::string::npos) << out;
+		EXPECT_NE(out.find(v), std::string::npos) << out;
+	}
+	EXPECT_EQ(test::runCommand(tool + fr1 + " --set features.pyramid_pixel_centres=maybe", &out), 1);
+	EXPECT_NE(out.find("'maybe' is not a boolean"), std::string::npos) << out;
 	// --dump-config output is itself a valid configuration.
 	ASSERT_EQ(test::runCommand(tool + " --dump-config > " + dir + "/dump.ini"), 0);
 	EXPECT_NO_THROW(slam::SlamConfig::FromFile(dir + "/dump.ini"));

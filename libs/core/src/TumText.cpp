@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 
@@ -9,6 +10,8 @@ namespace keygrid::core
 {
 std::vector<TextRecord> readTumTextRecords(const std::string& path)
 {
+	// A folder opens as a stream that reads nothing: name it instead of reading no lines.
+	if (std::filesystem::is_directory(path)) throw std::runtime_error("'" + path + "' is a folder, not a file");
 	std::ifstream f(path);
 	if (!f) throw std::runtime_error("cannot open '" + path + "'");
 	std::vector<TextRecord> out;

@@ -1,3 +1,4 @@
+#include <keygrid/core/ConfigReading.h>
 #include <keygrid/sfm/FeatureExtractor.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <opencv2/calib3d.hpp>
@@ -12,17 +13,18 @@ namespace keygrid::sfm
 void FeatureOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
 	type = c.read_string(s, "type", type);
-	numFeatures = c.read_int(s, "num_features", numFeatures);
-	scaleFactor = c.read_double(s, "scale_factor", scaleFactor);
-	numLevels = c.read_int(s, "num_levels", numLevels);
-	fastThreshold = c.read_int(s, "fast_threshold", fastThreshold);
-	oversampling = c.read_double(s, "oversampling", oversampling);
-	gridCols = c.read_int(s, "grid_cols", gridCols);
-	gridRows = c.read_int(s, "grid_rows", gridRows);
-	minDepth = c.read_double(s, "min_depth", minDepth);
-	maxDepth = c.read_double(s, "max_depth", maxDepth);
-	maxDepthDiscontinuity = c.read_double(s, "max_depth_discontinuity", maxDepthDiscontinuity);
-	pyramidPixelCentres = c.read_bool(s, "pyramid_pixel_centres", pyramidPixelCentres);
+	// Integer ranges also bound memory (keypoints, pyramid images, grid cells per frame).
+	numFeatures = static_cast<int>(core::readInteger(c, s, "num_features", numFeatures, 10, kMaxFeatures));
+	scaleFactor = core::readFiniteNumber(c, s, "scale_factor", scaleFactor);
+	numLevels = static_cast<int>(core::readInteger(c, s, "num_levels", numLevels, 1, 16));
+	fastThreshold = static_cast<int>(core::readInteger(c, s, "fast_threshold", fastThreshold, 1, 255));
+	oversampling = core::readFiniteNumber(c, s, "oversampling", oversampling);
+	gridCols = static_cast<int>(core::readInteger(c, s, "grid_cols", gridCols, 1, 1000));
+	gridRows = static_cast<int>(core::readInteger(c, s, "grid_rows", gridRows, 1, 1000));
+	minDepth = core::readFiniteNumber(c, s, "min_depth", minDepth);
+	maxDepth = core::readFiniteNumber(c, s, "max_depth", maxDepth);
+	maxDepthDiscontinuity = core::readFiniteNumber(c, s, "max_depth_discontinuity", maxDepthDiscontinuity);
+	pyramidPixelCentres = core::readBoolean(c, s, "pyramid_pixel_centres", pyramidPixelCentres);
 	std::string err;
 	if (!isValid(&err)) throw std::invalid_argument("[" + s + "] " + err);
 }
@@ -47,7 +49,8 @@ bool FeatureOptions::isValid(std::string* error) const
 {
 	std::ostringstream e;
 	if (type != "orb" && type != "sift") e << "type = '" << type << "' (expected orb or sift)";
-	else if (numFeatures < 10) e << "num_features = " << numFeatures << " (must be >= 10)";
+	else if (numFeatures < 10 || numFeatures > kMaxFeatures) e << "num_features = " << numFeatures << " (must be in [10, " << kMaxFeatures << "])";
+	else if (oversampling > 10.0) e << "oversampling = " << oversampling << " (must be <= 10)";
 	else if (!(scaleFactor > 1.0 && scaleFactor < 2.0)) e << "scale_factor = " << scaleFactor << " (must be in (1, 2))";
 	else if (numLevels < 1 || numLevels > 16) e << "num_levels = " << numLevels << " (must be 1..16)";
 	else if (oversampling < 1.0) e << "oversampling = " << oversampling << " (must be >= 1)";

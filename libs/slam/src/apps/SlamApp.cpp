@@ -66,6 +66,7 @@ std::string jsonEscape(const std::string& s)
 std::string effectiveConfigText(const std::string& path, const std::string& set)
 {
 	if (!mrpt::system::fileExists(path)) throw std::invalid_argument("config file '" + path + "' does not exist");
+	if (std::filesystem::is_directory(path)) throw std::invalid_argument("config file '" + path + "' is a folder, not a file");
 	std::string text = mrpt::io::file_get_contents(path);
 	if (set.empty()) return text;
 	const auto overrides = parseOverrides(set, "--set");
@@ -112,6 +113,13 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		if (ec || !mrpt::system::directoryExists(o.output))
 			throw std::runtime_error("cannot create output folder '" + o.output + "'" + (ec ? ": " + ec.message() : std::string()));
 	}
+	std::optional<core::Trajectory> gt;
+	if (!o.groundTruth.empty())
+	{
+		// Checked before the input is opened, not after the run.
+		gt = core::readTumTrajectory(o.groundTruth);
+		if (gt->empty()) throw std::invalid_argument("ground truth '" + o.groundTruth + "' holds no poses");
+	}
 	const OpenCvThreadsOff openCvThreadsOff;
 	core::FrameSourceOptions so;
 	if (!cfg.camera.empty() && cfg.camera != "auto") so.camera = core::RgbdCamera::FromPresetOrFile(cfg.camera);
@@ -124,8 +132,6 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	else
 		source = std::make_unique<core::PrefetchingFrameSource>(core::openFrameSource(o.input, so), 4);
 	core::FrameSource& input = live ? static_cast<core::FrameSource&>(*live) : *source;
-	std::optional<core::Trajectory> gt;
-	if (!o.groundTruth.empty()) gt = core::readTumTrajectory(o.groundTruth);
 
 	System sys(cfg);
 	if (!o.localize)

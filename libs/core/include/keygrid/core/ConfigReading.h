@@ -18,6 +18,19 @@ double readFiniteNumber(
 	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key,
 	double current);
 
+/** `key` of `section` as a whole number in [min, max] (no fraction, exponent or trailing
+ * text: "1000abc", "40.0.0", "1e3", "forty" are refused); a missing key keeps `current`.
+ * Throws std::invalid_argument naming section, key, value and the range. */
+long long readInteger(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key,
+	long long current, long long min, long long max);
+
+/** `key` of `section` as a boolean: true/false/1/0 only (any letter case); a missing key keeps
+ * `current`. Throws std::invalid_argument naming section, key and value ("maybe"). */
+bool readBoolean(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key,
+	bool current);
+
 /** `text` without leading and trailing blanks (space, tab, CR, LF). */
 std::string trimBlanks(const std::string& text);
 

@@ -20,7 +20,9 @@ struct FeatureOptions
 {
 	/** "orb" or "sift" (Default: orb) */
 	std::string type{"orb"};
-	/** Keypoints kept per frame after bucketing (Default: 1000) */
+	/** Upper bound of num_features (memory and time per frame). */
+	static constexpr int kMaxFeatures = 100000;
+	/** Keypoints kept per frame after bucketing, in [10, kMaxFeatures] (Default: 1000) */
 	int numFeatures{1000};
 	/** Pyramid scale step (Default: 1.2) */
 	double scaleFactor{1.2};
