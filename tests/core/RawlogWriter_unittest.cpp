@@ -54,3 +54,22 @@ TEST(RawlogWriter, AFullDiskIsReportedAndNothingIsLeftBehind)
 	EXPECT_FALSE(mrpt::system::fileExists(path));
 	EXPECT_FALSE(std::filesystem::is_symlink(path + ".tmp"));
 }
+
+// An output path that is a folder is refused when the writer is made, before any frame is
+// converted, and nothing is created beside it.
+TEST(RawlogWriter, AFolderAsOutputIsRefusedBeforeAnyFrame)
+{
+	const std::string dir = keygrid::test::scratchDir("rawlog_folder_output");
+	const std::string path = dir + "/existing";
+	std::filesystem::create_directories(path);
+	try
+	{
+		RawlogWriter w(path);
+		FAIL() << "no exception";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("'" + path + "' is a folder"), std::string::npos) << e.what();
+	}
+	EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+}

@@ -68,6 +68,34 @@ TEST(TumTrajectory, BadLinesThrowWithFileAndLineOrAreSkipped)
 	EXPECT_EQ(issues[3].line, 6u);
 }
 
+TEST(TumTrajectory, ARepeatedTimestampIsNamedOnTheLineThatRepeatsIt)
+{
+	const auto p = writeText(
+		"repeat",
+		"# header\n"
+		"2.0 0 0 0 0 0 0 1\n"
+		"1.0 0 0 0 0 0 0 1\n"
+		"2.0 1 0 0 0 0 0 1\n"  // line 4 repeats line 2's stamp
+		"3.0 0 0 0 0 0 0 1\n");
+	try
+	{
+		readTumTrajectory(p);
+		FAIL() << "no exception";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find(p + ":4: repeated timestamp 2.000000 (first on line 2)"), std::string::npos) << e.what();
+	}
+	TrajectoryReadOptions o;
+	o.skipBadLines = true;
+	std::vector<TextLineIssue> issues;
+	const auto t = readTumTrajectory(p, o, &issues);
+	ASSERT_EQ(t.size(), 3u);
+	EXPECT_DOUBLE_EQ(t[1].T_world_cam.x(), 0.0) << "the first of the repeated poses is kept";
+	ASSERT_EQ(issues.size(), 1u);
+	EXPECT_EQ(issues[0].line, 4u);
+}
+
 TEST(TumTrajectory, WriteReadRoundTrip)
 {
 	Trajectory in;

@@ -25,6 +25,8 @@ struct RawlogWriter::Impl
 RawlogWriter::RawlogWriter(const std::string& path, const RawlogWriterOptions& opts)
 	: m_impl(std::make_unique<Impl>()), m_path(path), m_tmpPath(path + ".tmp"), m_opts(opts)
 {
+	// Before any frame is converted: a folder cannot take the rawlog's name at the end.
+	if (std::filesystem::is_directory(path)) throw std::runtime_error("output '" + path + "' is a folder, not a file");
 	const std::string dir = mrpt::system::extractFileDirectory(path);
 	if (!dir.empty() && !mrpt::system::directoryExists(dir))
 		throw std::runtime_error("output folder '" + dir + "' does not exist");

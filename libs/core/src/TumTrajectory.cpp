@@ -13,7 +13,7 @@ namespace keygrid::core
 Trajectory readTumTrajectory(
 	const std::string& path, const TrajectoryReadOptions& opts, std::vector<TextLineIssue>* issues)
 {
-	Trajectory out;
+	std::vector<std::pair<StampedPose, std::size_t>> rows;  // pose, line
 	for (const auto& rec : readTumTextRecords(path))
 	{
 		auto bad = [&](const std::string& why) {
@@ -47,18 +47,27 @@ Trajectory readTumTrajectory(
 		StampedPose sp;
 		sp.t = v[0];
 		sp.T_world_cam = mrpt::poses::CPose3D(mrpt::poses::CPose3DQuat(v[1], v[2], v[3], q));
-		out.push_back(sp);
+		rows.emplace_back(sp, rec.line);
 	}
-	std::stable_sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
-	for (std::size_t i = 1; i < out.size(); i++)
-		if (out[i].t == out[i - 1].t)
+	// Sorted by time (a stable sort keeps the file's order among equal stamps); a repeated stamp
+	// is named on the line that repeats it.
+	std::stable_sort(rows.begin(), rows.end(), [](const auto& a, const auto& b) { return a.first.t < b.first.t; });
+	Trajectory out;
+	out.reserve(rows.size());
+	for (std::size_t i = 0; i < rows.size(); i++)
+	{
+		if (i > 0 && rows[i].first.t == rows[i - 1].first.t)
 		{
-			TextLineIssue is{path, 0, "repeated timestamp " + std::to_string(out[i].t)};
+			char t[64];
+			std::snprintf(t, sizeof(t), "%.6f", rows[i].first.t);
+			TextLineIssue is{path, rows[i].second, "repeated timestamp " + std::string(t) + " (first on line " + std::to_string(rows[i - 1].second) + ")"};
 			if (!opts.skipBadLines) throw std::runtime_error(is.str());
 			if (issues) issues->push_back(is);
-			out.erase(out.begin() + static_cast<std::ptrdiff_t>(i));
-			--i;
+			rows[i].second = rows[i - 1].second;  // a third repeat names the first line too
+			continue;
 		}
+		out.push_back(rows[i].first);
+	}
 	return out;
 }
 
