@@ -71,12 +71,31 @@ TEST(VocabApp, BadCommandLinesFailWithOneLine)
 	EXPECT_NE(log.find("surf"), std::string::npos) << log;
 }
 
-TEST(VocabApp, TrainsOnARawlog)
+TEST(VocabApp, ReadsARawlogAndRefusesToTrainOnOneImage)
 {
+	// The rawlog's one frame is read (its descriptors extracted), but one image gives every
+	// word the idf weight 0: refused, and no file written.
 	const std::string rawlog = keygrid::test::mrptDatasetsDir() + "/tests_rgbd.rawlog";
 	if (!std::filesystem::exists(rawlog)) GTEST_SKIP() << rawlog << " not installed";
 	const std::string out = scratchDir("loop_vocab_app_rawlog") + "/vocab.bin";
+	std::filesystem::remove(out);
 	std::string log;
-	ASSERT_EQ(runCommand(toolPath("keygrid-vocab") + " train --rawlog " + rawlog + " --output " + out + " --k 5 --levels 2", &log), 0) << log;
-	EXPECT_EQ(keygrid::loop::Vocabulary::load(out).trainingImages(), 1u);
+	EXPECT_EQ(runCommand(toolPath("keygrid-vocab") + " train --rawlog " + rawlog + " --output " + out + " --k 5 --levels 2", &log), 1) << log;
+	EXPECT_NE(log.find("at least 2 images with features, got 1"), std::string::npos) << log;
+	EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(VocabApp, RefusesImagesThatGiveNoWordAWeight)
+{
+	// Six copies of one image: every word is in every image.
+	const std::string dir = scratchDir("loop_vocab_app_same");
+	const std::string images = dir + "/images";
+	std::filesystem::create_directories(images);
+	for (int i = 0; i < 6; ++i) cv::imwrite(images + "/img" + std::to_string(i) + ".png", proceduralImage(7));
+	const std::string out = dir + "/vocab.bin";
+	std::filesystem::remove(out);
+	std::string log;
+	EXPECT_EQ(runCommand(toolPath("keygrid-vocab") + " train --images " + images + " --output " + out + " --k 4 --levels 2", &log), 1) << log;
+	EXPECT_NE(log.find("every word weighs 0"), std::string::npos) << log;
+	EXPECT_FALSE(std::filesystem::exists(out));
 }

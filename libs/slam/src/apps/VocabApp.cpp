@@ -139,10 +139,23 @@ int train(const core::CommandLine& cl)
 		bar.finish(std::to_string(total) + " descriptors");
 	}
 	if (total == 0) throw std::runtime_error("no descriptors extracted (no images or no texture)");
+	// idf = log(images / images with the word): with one image every word has weight 0 and
+	// every place would score alike.
+	const auto withFeatures = std::count_if(descriptors.begin(), descriptors.end(), [](const cv::Mat& d) { return d.rows > 0; });
+	if (withFeatures < 2)
+		throw std::runtime_error(
+			"training needs at least 2 images with features, got " + std::to_string(withFeatures) +
+			" (with one, every word is in every image and weighs 0)");
 
 	core::ProgressBar bar("clustering", total);
 	const loop::Vocabulary v = loop::Vocabulary::train(descriptors, vo, [&](std::size_t done, std::size_t) { bar.update(done); });
 	bar.finish();
+	bool anyWeight = false;
+	for (std::size_t w = 0; w < v.numWords() && !anyWeight; ++w) anyWeight = v.idf(static_cast<loop::WordId>(w)) > 0;
+	if (!anyWeight)
+		throw std::runtime_error(
+			"every word of the vocabulary is in every one of the " + std::to_string(withFeatures) +
+			" training images, so every word weighs 0: train on more, and more varied, images");
 	std::ostringstream os;
 	v.save(os);
 	writeFileAtomically(cl.get("output"), os.str());
