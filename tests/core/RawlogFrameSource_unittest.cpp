@@ -82,7 +82,7 @@ TEST(RawlogFrameSource, SkipsNonRgbdAndReportsTruncation)
 	f.depthRaw = cv::Mat(6, 8, CV_16UC1, cv::Scalar(5000));
 	{
 		RawlogWriter w(dir + "/mixed.rawlog");
-		w.write(mrpt::obs::CObservation2DRangeScan::Create());  // not RGB-D: ignored
+		w.write(mrpt::obs::CObservation2DRangeScan::Create());  // not RGB-D: counted skip
 		w.write(makeRgbdObservation(f));
 		auto noImage = makeRgbdObservation(f);
 		noImage->hasIntensityImage = false;
@@ -96,7 +96,7 @@ TEST(RawlogFrameSource, SkipsNonRgbdAndReportsTruncation)
 		int n = 0;
 		while (src.next(g)) ++n;
 		EXPECT_EQ(n, 2);
-		EXPECT_EQ(src.skippedCount(), 1u);
+		EXPECT_EQ(src.skippedCount(), 2u);
 		EXPECT_NE(src.lastSkipReason().find("no intensity image"), std::string::npos);
 	}
 	// Truncate the file in the middle of the second observation.

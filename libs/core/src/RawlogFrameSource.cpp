@@ -136,9 +136,15 @@ bool RawlogFrameSource::next(Frame& out)
 			noteSkip(
 				"rawlog entry " + std::to_string(m_impl->entry - 1) + ": unexpected object " +
 				(obj ? std::string(obj->GetRuntimeClass()->className) : std::string("(null)")));
+		// Other sensors' observations (a rawlog-grabber log may hold an IMU or a laser too) are
+		// skipped and counted, so that a rawlog with no RGB-D entry says why it gave no frame.
 		auto take = [&](const CObservation::Ptr& o) {
 			if (auto s = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
 				m_impl->pending.push_back(s);
+			else if (o)
+				noteSkip(
+					"rawlog entry " + std::to_string(m_impl->entry - 1) + ": " + o->GetRuntimeClass()->className +
+					" is not an RGB-D observation");
 		};
 		if (obs) take(obs);
 		if (sf)

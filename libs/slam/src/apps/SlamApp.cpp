@@ -170,6 +170,16 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		bar.update(st.frames, extra);
 	};
 	auto limitReached = [&](std::size_t n) { return o.maxFrames && n >= o.maxFrames; };
+	struct
+	{
+		std::size_t count{0};
+		std::string last;
+		void note(const std::string& why)
+		{
+			++count;
+			last = why;
+		}
+	} timeSkips;  // frames dropped for their timestamps (the producer thread's, read after it joined)
 
 	try
 	{
@@ -196,10 +206,23 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 					core::Frame skippedFrame;
 					for (std::size_t n = 0; n < o.firstFrame && !interruptRequested(); n++)
 						if (!source->next(skippedFrame)) break;
-					for (std::size_t n = 0; !limitReached(n) && !interruptRequested(); n++)
+					std::optional<double> lastStamp;
+					for (std::size_t n = 0; !limitReached(n) && !interruptRequested();)
 					{
 						Extracted e;
 						if (!source->next(e.frame)) break;
+						// Time must go forward: a frame without a timestamp, or not after the
+						// previous one, would give the trajectory a repeated or backward stamp.
+						if (!(e.frame.timestamp > 0) || (lastStamp && !(e.frame.timestamp > *lastStamp)))
+						{
+							char why[160];
+							std::snprintf(why, sizeof(why), "frame %zu: timestamp %.6f %s", e.frame.index, e.frame.timestamp,
+										  e.frame.timestamp > 0 ? "is not after the previous frame's" : "is missing");
+							timeSkips.note(why);
+							continue;
+						}
+						lastStamp = e.frame.timestamp;
+						n++;
 						e.loadSeconds = source->lastLoadSeconds();
 						const auto t0 = Clock::now();
 						e.features = sys.extract(e.frame);
@@ -244,8 +267,12 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		res.error = e.what();
 	}
 	bar.finish();
-	const std::size_t skipped = live ? live->innerSkipped() : source->innerSkipped();
-	const std::string lastSkip = live ? std::string() : source->innerLastSkipReason();
+	const std::size_t skipped = (live ? live->innerSkipped() : source->innerSkipped()) + timeSkips.count;
+	const std::string lastSkip = !timeSkips.last.empty() ? timeSkips.last : live ? std::string() : source->innerLastSkipReason();
+	res.skipped = skipped;
+	res.lastSkip = lastSkip;
+	if (res.error.empty() && sys.stats().frames == 0 && !interruptRequested())
+		res.error = "no RGB-D frame in the input" + (skipped ? " (" + std::to_string(skipped) + " entries skipped, the last: " + lastSkip + ")" : std::string());
 	if (skipped)
 		std::cerr << "keygrid-slam: warning: skipped " << skipped << " input entries"
 				  << (lastSkip.empty() ? std::string() : " (last: " + lastSkip + ")") << "\n";

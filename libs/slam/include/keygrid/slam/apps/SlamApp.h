@@ -45,6 +45,10 @@ struct SlamRunResult
 	std::size_t liveGrabbed{0}, liveDropped{0};  //!< live runs: camera frames, and those skipped
 	/** Localization mode: frames localized in the loaded map */
 	std::size_t localized{0};
+	/** Input entries skipped (not RGB-D, unreadable, or a timestamp not after the previous
+	 * frame's), and why the last one was */
+	std::size_t skipped{0};
+	std::string lastSkip;
 };
 
 /** Runs one sequence end to end; throws on bad configuration or unopenable input. */
