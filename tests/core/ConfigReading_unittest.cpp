@@ -43,6 +43,10 @@ TEST(ConfigReading, IntegersAreWholeNumbersInTheirRange)
 		const auto e = errorOf([&] { core::readInteger(c, "s", "k", 1, 0, 1000000); });
 		EXPECT_NE(e.find("[s] k = '" + bad + "' is not a whole number in [0, 1000000]"), std::string::npos) << bad << ": " << e;
 	}
+	c.write("s", "k", std::string("2.5"));
+	EXPECT_NE(errorOf([&] { core::readWholeNumber(c, "s", "k", 1); }).find("[s] k = '2.5' is not a whole number"), std::string::npos);
+	c.write("s", "k", std::string("-12"));
+	EXPECT_EQ(core::readWholeNumber(c, "s", "k", 1), -12);
 	c.write("s", "k", std::string("1001"));
 	EXPECT_NE(errorOf([&] { core::readInteger(c, "s", "k", 1, 0, 1000); }).find("[s] k = 1001 is out of range [0, 1000]"), std::string::npos);
 }

@@ -1,8 +1,10 @@
 // keygrid-slam end to end: the shipped INI on real TUM frames (when ../shared/data is present),
 // determinism, threaded mode, report contents and bad inputs.
 #include <keygrid/core/TumTrajectory.h>
+#include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <keygrid/slam/apps/SlamApp.h>
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/system/filesystem.h>
 
 #include "TestData.h"
@@ -187,9 +189,91 @@ TEST(SlamApp, UnknownKeysOfSlamSectionsAreNamedAndShippedConfigsAreClean)
 			EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
 		}
 	}
-	// Sections that are not SlamConfig's (map plugins, MRPT) are left to their owners.
-	std::ofstream(dir + "/other.ini") << "[MappingApplication]\npointsMap_count = 1\n[custom]\nanything = 1\n";
+	// The map plugins' and the live camera's sections are left to their owners; any other
+	// section is a typo, named (a misspelt [trackr] would be ignored with all its keys).
+	std::ofstream(dir + "/other.ini") << "[MappingApplication]\npointsMap_count = 1\n[MappingApplication_pointsMap_00_insertOpts]\nminDistBetweenLaserPoints = 0.1\n[live_LEFT]\nx = 1\n";
 	EXPECT_NO_THROW(slam::SlamConfig::FromFile(dir + "/other.ini"));
+	std::ofstream(dir + "/typo.ini") << "[trackr]\nclose_depth = 3\n";
+	try
+	{
+		slam::SlamConfig::FromFile(dir + "/typo.ini");
+		ADD_FAILURE() << "accepted [trackr]";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("[trackr]: unknown section"), std::string::npos) << e.what();
+	}
+}
+
+TEST(SlamApp, ConfigTextThatMrptWouldSkipIsAnError)
+{
+	// MRPT's reader skips lines it cannot parse: an unclosed section header, a stray word, a
+	// binary file would all run with defaults.
+	const std::string dir = test::scratchDir("slam_config_text");
+	const std::string tool = test::toolPath("keygrid-slam");
+	std::string out;
+	std::ofstream(dir + "/unclosed.ini") << "[slam]\nmode = sequential\n[tracker\nclose_depth = 3\n";
+	EXPECT_EQ(test::runCommand(tool + " --config " + dir + "/unclosed.ini --input x --output " + dir, &out), 1);
+	EXPECT_NE(out.find("unclosed.ini:3: '[tracker' is not a [section] line"), std::string::npos) << out;
+	std::ofstream(dir + "/stray.ini") << "# comment\n[slam]\nmode sequential\n";
+	EXPECT_EQ(test::runCommand(tool + " --config " + dir + "/stray.ini --input x --output " + dir, &out), 1);
+	EXPECT_NE(out.find("stray.ini:3: 'mode sequential' is not a [section], a key = value or a comment"), std::string::npos) << out;
+	{
+		std::ofstream bin(dir + "/binary.ini", std::ios::binary);
+		const char bytes[] = {'\x7f', 'E', 'L', 'F', '\0', '\x01', '\n', 'x'};
+		bin.write(bytes, sizeof(bytes));
+	}
+	EXPECT_EQ(test::runCommand(tool + " --config " + dir + "/binary.ini --input x --output " + dir, &out), 1);
+	EXPECT_NE(out.find("not a text file"), std::string::npos) << out;
+}
+
+TEST(SlamApp, EveryValueMustBeOfItsDefaultsKind)
+{
+	// MRPT's readers would run with 0, 1000, 1 and false.
+	const std::pair<const char*, const char*> bad[] = {
+		{"[tracker]\nclose_depth = abc\n", "close_depth = 'abc' is not a finite number"},
+		{"[tracker]\nclose_depth = inf\n", "close_depth = 'inf' is not a finite number"},
+		{"[tracker]\nmin_inliers = 1000abc\n", "min_inliers = '1000abc' is not a whole number"},
+		{"[tracker]\nmin_inliers = 1e3\n", "min_inliers = '1e3' is not a whole number"},
+		{"[tracker]\nmin_inliers = 40.0.0\n", "min_inliers = '40.0.0' is not a whole number"},
+		{"[loop_closing]\nenabled = maybe\n", "enabled = 'maybe' is not a boolean"}};
+	for (const auto& [text, message] : bad)
+	{
+		try
+		{
+			slam::SlamConfig::FromConfig(mrpt::config::CConfigFileMemory(std::string(text)), "test.ini");
+			ADD_FAILURE() << "accepted " << text;
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+		}
+	}
+	// Each kind in its right form is accepted.
+	EXPECT_NO_THROW(slam::SlamConfig::FromConfig(
+		mrpt::config::CConfigFileMemory(std::string("[tracker]\nclose_depth = 2.5\nmin_inliers = 30\n[loop_closing]\nenabled = 0\n")), "ok.ini"));
+}
+
+TEST(SlamApp, MapSectionsThatNoMapReadsAreNamed)
+{
+	const auto errorOf = [](const std::string& text)
+	{
+		try
+		{
+			slam::MetricMaps maps(mrpt::config::CConfigFileMemory(text), {});
+		}
+		catch (const std::invalid_argument& e)
+		{
+			return std::string(e.what());
+		}
+		return std::string();
+	};
+	const std::string maps = "[MappingApplication]\nismOccupancyGrid2D_count = 1\n";
+	EXPECT_EQ(errorOf(maps + "[MappingApplication_ismOccupancyGrid2D_00_insertOpts]\nmaxRange = 4\n"), "");
+	EXPECT_NE(errorOf("[MappingApplication]\nismOccupancyGrid2D_count = one\n").find("ismOccupancyGrid2D_count = 'one' is not a whole number"), std::string::npos);
+	EXPECT_NE(errorOf(maps + "[MappingApplication_ismOccupancyGrid2D_00_insertOpt]\nmaxRange = 4\n").find("unknown option group 'insertOpt'"), std::string::npos);
+	EXPECT_NE(errorOf(maps + "[MappingApplication_ismOccupancyGrid2D_01_insertOpts]\nmaxRange = 4\n").find("no map 01 of type 'ismOccupancyGrid2D'"), std::string::npos);
+	EXPECT_NE(errorOf(maps + "[MappingApplication_ismOccupancyGrid_00_insertOpts]\nmaxRange = 4\n").find("no map 00 of type 'ismOccupancyGrid'"), std::string::npos);
 }
 
 TEST(SlamApp, SetOverridesKeysLikeTheFileWouldAndRejectsUnknownOnes)

@@ -181,12 +181,13 @@ void appendTable(std::ostringstream& md, const IniSection& s, const std::string&
 }
 }  // namespace
 
-std::vector<IniSection> slamConfigReference()
+std::vector<IniSection> slamConfigReference(bool tidyNumbers)
 {
 	RecordingConfig rec;
 	SlamConfig().saveToConfigFile(rec);
-	for (auto& s : rec.written)
-		for (auto& k : s.keys) k.defaultValue = tidyNumber(k.defaultValue);
+	if (tidyNumbers)
+		for (auto& s : rec.written)
+			for (auto& k : s.keys) k.defaultValue = tidyNumber(k.defaultValue);
 	return rec.written;
 }
 

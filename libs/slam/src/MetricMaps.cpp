@@ -1,3 +1,4 @@
+#include <keygrid/core/ConfigReading.h>
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
@@ -8,6 +9,8 @@
 
 #include <chrono>
 #include <filesystem>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -85,6 +88,37 @@ CHOCPointsMap hocPointsFromLandmarks(const sfm::SparseMap& map, const maps::HocO
 	return m;
 }
 
+namespace
+{
+/** Every [MappingApplication_<type>_<NN>_<group>] section belongs to a configured map
+ * (<type>_count > NN) and is an option group MRPT's maps read; a misspelt one would be
+ * ignored with all its keys. */
+void checkMapSections(const mrpt::config::CConfigFileBase& cfg, const std::map<std::string, int>& counts)
+{
+	static const std::regex pattern(std::string(MetricMaps::kSection) + "_(.+)_([0-9]+)_([A-Za-z]+)");
+	static const std::set<std::string> groups = {"creationOpts", "insertOpts", "likelihoodOpts", "renderOpts", "colorOpts"};
+	const std::string prefix = std::string(MetricMaps::kSection) + "_";
+	std::vector<std::string> sections;
+	cfg.getAllSections(sections);
+	for (const auto& name : sections)
+	{
+		if (name.compare(0, prefix.size(), prefix) != 0) continue;
+		std::smatch m;
+		if (!std::regex_match(name, m, pattern))
+			throw std::invalid_argument("[" + name + "]: not a map option section (expected " + prefix + "<type>_<NN>_<group>)");
+		const auto c = counts.find(m[1].str());
+		const int index = std::stoi(m[2].str());
+		if (c == counts.end() || index >= c->second)
+			throw std::invalid_argument(
+				"[" + name + "]: no map " + m[2].str() + " of type '" + m[1].str() + "' is configured ([" +
+				MetricMaps::kSection + "] " + m[1].str() + "_count = " + (c == counts.end() ? std::string("(none)") : std::to_string(c->second)) + ")");
+		if (!groups.count(m[3].str()))
+			throw std::invalid_argument(
+				"[" + name + "]: unknown option group '" + m[3].str() + "' (creationOpts, insertOpts, likelihoodOpts, renderOpts, colorOpts)");
+	}
+}
+}  // namespace
+
 MetricMaps::MetricMaps(
 	const mrpt::config::CConfigFileBase& cfg, const MapFeedOptions& feed, const maps::FloorFrameOptions& floor)
 	: m_feed(feed), m_floor(floor)
@@ -93,18 +127,20 @@ MetricMaps::MetricMaps(
 	std::vector<std::string> keys;
 	cfg.getAllKeys(kSection, keys);
 	std::size_t requested = 0;
+	std::map<std::string, int> counts;
 	for (const auto& k : keys)
 	{
 		if (k.size() < 7 || k.substr(k.size() - 6) != "_count") continue;
 		const std::string name = k.substr(0, k.size() - 6);
-		const int n = cfg.read_int(kSection, k, 0);
-		if (n < 0) throw std::invalid_argument(std::string("[") + kSection + "] " + k + " = " + std::to_string(n) + " (must be >= 0)");
+		const int n = static_cast<int>(core::readInteger(cfg, kSection, k, 0, 0, 16));
+		counts[name] = n;
 		if (n > 0 && !knownMapType(name))
 			throw std::invalid_argument(
 				std::string("[") + kSection + "] " + k + ": no map type '" + name +
 				"' is registered (typo, or its plugin library is not loaded)");
 		requested += static_cast<std::size_t>(n);
 	}
+	checkMapSections(cfg, counts);
 	mrpt::maps::TSetOfMetricMapInitializers init;
 	init.loadFromConfigFile(cfg, kSection);
 	m_maps.setListOfMaps(init);

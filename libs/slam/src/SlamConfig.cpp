@@ -1,3 +1,4 @@
+#include <keygrid/core/ConfigReading.h>
 #include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <mrpt/config/CConfigFile.h>
@@ -69,21 +70,57 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	c.write("refinement", "map_reanchor_depth", refinement.mapReanchorDepth, 30, 40, "...measured also at this depth ahead of the camera [m]");
 }
 
+namespace
+{
+/** A value must be of its default's kind (MRPT's readers turn "forty" into 0, "1000abc" into
+ * 1000, "1e3" for an integer into 1 and "maybe" into false): a boolean default takes
+ * true/false/1/0, an integer default (written without a decimal point) a whole number, a
+ * floating-point one a finite number; text is its reader's to check. */
+void checkValueLikeDefault(const mrpt::config::CConfigFileBase& c, const std::string& section, const IniKey& ref)
+{
+	const std::string& d = ref.defaultValue;
+	double number = 0;
+	if (d == "true" || d == "false")
+		core::readBoolean(c, section, ref.key, false);
+	else if (!d.empty() && d.find_first_not_of("-0123456789") == std::string::npos)
+		core::readWholeNumber(c, section, ref.key, 0);
+	else if (core::parseTrimmedDouble(d, number))
+		core::readFiniteNumber(c, section, ref.key, 0.0);
+}
+}  // namespace
+
 void SlamConfig::checkKnownKeys(const mrpt::config::CConfigFileBase& c)
 {
+	// Every section is one SlamConfig owns, a map plugin's (MetricMaps checks those) or the
+	// live camera's: a misspelt section would otherwise be ignored with all its keys.
+	const auto reference = slamConfigReference(false);
+	std::vector<std::string> sections;
+	c.getAllSections(sections);
+	for (const auto& name : sections)
+	{
+		const auto startsWith = [&](const std::string& p) { return name.compare(0, p.size(), p) == 0; };
+		const bool ours = std::any_of(reference.begin(), reference.end(), [&](const IniSection& r) { return r.name == name; });
+		if (ours || name.empty() || name == "MappingApplication" || startsWith("MappingApplication_") || name == "live" || startsWith("live_")) continue;
+		std::string known;
+		for (const auto& r : reference) known += (known.empty() ? "" : ", ") + r.name;
+		throw std::invalid_argument(
+			"[" + name + "]: unknown section (keygrid-slam reads " + known +
+			", the map plugins' MappingApplication*, the live camera's live*)");
+	}
 	// The sections SlamConfig owns, with the keys its saveToConfigFile writes. (Map sections
 	// belong to the plugins; MetricMaps checks those by type.)
-	for (const auto& sec : slamConfigReference())
+	for (const auto& sec : reference)
 	{
 		if (!c.sectionExists(sec.name)) continue;
 		std::vector<std::string> keys;
 		c.getAllKeys(sec.name, keys);
 		for (const auto& k : keys)
 		{
-			const bool known = std::any_of(sec.keys.begin(), sec.keys.end(), [&](const IniKey& r) { return r.key == k; });
-			if (!known)
+			const auto ref = std::find_if(sec.keys.begin(), sec.keys.end(), [&](const IniKey& r) { return r.key == k; });
+			if (ref == sec.keys.end())
 				throw std::invalid_argument(
 					"[" + sec.name + "] " + k + ": unknown key (typo? `keygrid-slam --dump-config` lists every key)");
+			checkValueLikeDefault(c, sec.name, *ref);
 		}
 	}
 }

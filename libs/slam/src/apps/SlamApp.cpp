@@ -1,3 +1,4 @@
+#include <keygrid/core/ConfigReading.h>
 #include <keygrid/core/BoundedQueue.h>
 #include <keygrid/core/CommandLine.h>
 #include <keygrid/core/FrameSource.h>
@@ -68,6 +69,7 @@ std::string effectiveConfigText(const std::string& path, const std::string& set)
 	if (!mrpt::system::fileExists(path)) throw std::invalid_argument("config file '" + path + "' does not exist");
 	if (std::filesystem::is_directory(path)) throw std::invalid_argument("config file '" + path + "' is a folder, not a file");
 	std::string text = mrpt::io::file_get_contents(path);
+	core::checkIniText(text, path);
 	if (set.empty()) return text;
 	const auto overrides = parseOverrides(set, "--set");
 	checkOverrideKeys(text, overrides, "--set");

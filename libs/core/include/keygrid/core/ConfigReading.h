@@ -25,11 +25,20 @@ long long readInteger(
 	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key,
 	long long current, long long min, long long max);
 
+/** readInteger without a range (its reader checks it): at most 18 digits. */
+long long readWholeNumber(
+	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key, long long current);
+
 /** `key` of `section` as a boolean: true/false/1/0 only (any letter case); a missing key keeps
  * `current`. Throws std::invalid_argument naming section, key and value ("maybe"). */
 bool readBoolean(
 	const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& key,
 	bool current);
+
+/** Throws std::invalid_argument("<origin>:<line>: ...") unless every line of an INI text is
+ * blank, a comment (#, ; or //), a [section], a key = value or an MRPT directive (@...):
+ * MRPT's reader skips any other line silently (an unclosed "[tracker", a binary file). */
+void checkIniText(const std::string& text, const std::string& origin);
 
 /** `text` without leading and trailing blanks (space, tab, CR, LF). */
 std::string trimBlanks(const std::string& text);

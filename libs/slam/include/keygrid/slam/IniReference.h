@@ -24,8 +24,10 @@ struct IniSection
 	std::vector<IniKey> keys;  //!< in the order the options struct writes them
 };
 
-/** The sections of SlamConfig's defaults, in the order saveToConfigFile writes them. */
-std::vector<IniSection> slamConfigReference();
+/** The sections of SlamConfig's defaults, in the order saveToConfigFile writes them.
+ * `tidyNumbers`: "3.000000" as "3" (for people); false keeps what MRPT's write() made of each
+ * type (a double always has a decimal point, an integer never). */
+std::vector<IniSection> slamConfigReference(bool tidyNumbers = true);
 
 /** The INI names (e.g. "ismOccupancyGrid2D") of every keygrid map class registered with MRPT's
  * map factory, sorted. */
