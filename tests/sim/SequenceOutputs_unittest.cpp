@@ -196,3 +196,40 @@ TEST(SequenceOutputs, ToolOutputsAreReadable)
 		0);
 	EXPECT_NE(log.find("does not exist"), std::string::npos) << log;
 }
+
+TEST(SequenceOutputs, AStoppedRunWritesTheFramesSoFarAsAWholeSequence)
+{
+	const sim::Scene scene = test::sceneFromString(tinyRoomIni(5));
+	sim::OutputOptions o;
+	const std::string dir = test::scratchDir("sim_stopped");
+	std::size_t asked = 0;
+	// Stop before the third frame (Ctrl-C in keygrid-sim).
+	const auto s = sim::writeSequence(scene, dir, o, {}, 1, [&] { return ++asked > 2; });
+	EXPECT_TRUE(s.stopped);
+	EXPECT_EQ(s.frames, 2u);
+	EXPECT_EQ(core::readTumTrajectory(dir + "/groundtruth.txt").size(), 2u);
+	core::TumFrameSource tum(dir + "/tum");
+	core::Frame f;
+	std::size_t n = 0;
+	while (tum.next(f)) n++;
+	EXPECT_EQ(n, 2u);
+	for (const auto& file : listFiles(dir)) EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+}
+
+TEST(SequenceOutputs, AWriteErrorLeavesNoListOrRawlogUnderItsFinalName)
+{
+	const sim::Scene scene = test::sceneFromString(tinyRoomIni(5));
+	sim::OutputOptions o;
+	o.voxelResolution = 0;
+	o.floorPlanResolution = 0;
+	const std::string dir = test::scratchDir("sim_write_error");
+	std::filesystem::remove_all(dir);
+	// The second frame's colour image cannot be written: a folder holds its name.
+	char ts[32];
+	std::snprintf(ts, sizeof(ts), "%.6f", scene.timestamp(1));
+	std::filesystem::create_directories(dir + "/tum/rgb/" + ts + ".png");
+	EXPECT_THROW(sim::writeSequence(scene, dir, o, {}, 1), std::runtime_error);
+	for (const char* f : {"sequence.rawlog", "groundtruth.txt", "tum/rgb.txt", "tum/depth.txt", "tum/associations.txt"})
+		EXPECT_FALSE(std::filesystem::exists(dir + "/" + f)) << f;
+	for (const auto& file : listFiles(dir)) EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+}

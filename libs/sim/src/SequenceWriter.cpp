@@ -60,7 +60,7 @@ void OutputOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std
 
 SequenceSummary writeSequence(
 	const Scene& scene, const std::string& dir, const OutputOptions& o,
-	const std::function<void(std::size_t, std::size_t)>& progress, unsigned threads)
+	const std::function<void(std::size_t, std::size_t)>& progress, unsigned threads, const std::function<bool()>& stop)
 {
 	if (scene.trajectory.empty())
 		throw std::invalid_argument(
@@ -93,6 +93,11 @@ SequenceSummary writeSequence(
 	const std::size_t n = scene.options.frames;
 	for (std::size_t i = 0; i < n; i++)
 	{
+		if (stop && stop())
+		{
+			sum.stopped = true;
+			break;
+		}
 		SimFrame& f = out.next();
 		const auto r0 = Clock::now();
 		sim.frame(i, f);
@@ -104,8 +109,8 @@ SequenceSummary writeSequence(
 	out.close(
 		"ground truth of keygrid-sim scene '" + scene.options.name +
 		"': T_world_cam of the optical frame (x right, y down, z forward), world z up");
-	sum.frames = n;
-	sum.dynamicPixelFraction = n ? dynSum / n : 0;
+	sum.frames = out.count();
+	sum.dynamicPixelFraction = sum.frames ? dynSum / static_cast<double>(sum.frames) : 0;
 	sum.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 	return sum;
 }

@@ -3,6 +3,7 @@
 #include <keygrid/sim/Augment.h>
 #include <keygrid/sim/Scene.h>
 #include <keygrid/sim/SequenceWriter.h>
+#include <keygrid/slam/Interrupt.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/BatchExperiment.h>
 #include <keygrid/slam/apps/SimApp.h>
@@ -10,6 +11,7 @@
 #include <mrpt/io/vector_loadsave.h>
 #include <mrpt/system/filesystem.h>
 
+#include <csignal>
 #include <cstdio>
 #include <iostream>
 #include <stdexcept>
@@ -129,9 +131,11 @@ int SimApp::run(int argc, const char* const* argv)
 			return 0;
 		}
 		core::ProgressBar bar("rendering", scene.options.frames, !quiet);
+		// Ctrl-C / SIGTERM: the frames rendered so far are written as a shorter sequence.
+		installInterruptHandlers();
 		const sim::SequenceSummary s = sim::writeSequence(
 			scene, dir, out, [&](std::size_t done, std::size_t) { bar.update(done); },
-			static_cast<unsigned>(threads));
+			static_cast<unsigned>(threads), [] { return interruptRequested(); });
 		bar.finish();
 		char line[512];
 		std::snprintf(
@@ -143,6 +147,11 @@ int SimApp::run(int argc, const char* const* argv)
 			s.renderSeconds > 0 ? s.frames / s.renderSeconds : 0.0, s.maxSpeed, s.maxTurnRateDeg,
 			s.voxels, s.floorPlanCells, 100.0 * s.dynamicPixelFraction);
 		std::cout << line;
+		if (s.stopped)
+		{
+			std::cerr << "keygrid-sim: interrupted after " << s.frames << " of " << scene.options.frames << " frames (written)\n";
+			return 128 + (interruptSignal() ? interruptSignal() : SIGINT);
+		}
 		return 0;
 	});
 }

@@ -53,12 +53,16 @@ struct SequenceSummary
 	double renderSeconds{0};                //!< of which rendering + sensor model
 	double maxSpeed{0}, maxTurnRateDeg{0};  //!< of the camera trajectory
 	double dynamicPixelFraction{0};         //!< mean over frames
+	bool stopped{false};                    //!< `stop` ended the run before the last frame
 };
 
 /** Renders every frame of `scene` and writes the outputs above into `dir` (created if
- * needed). `progress(done, total)` is called after each frame when given. */
+ * needed). `progress(done, total)` is called after each frame when given. When `stop`
+ * returns true (checked before each frame) the frames so far are written as a complete,
+ * shorter sequence. On an error nothing keeps a list's or the rawlog's final name. */
 SequenceSummary writeSequence(
 	const Scene& scene, const std::string& dir, const OutputOptions& opts,
-	const std::function<void(std::size_t, std::size_t)>& progress = {}, unsigned threads = 0);
+	const std::function<void(std::size_t, std::size_t)>& progress = {}, unsigned threads = 0,
+	const std::function<bool()>& stop = {});
 
 }  // namespace keygrid::sim
