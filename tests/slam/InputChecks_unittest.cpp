@@ -12,6 +12,7 @@
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <opencv2/core.hpp>
 
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -86,4 +87,28 @@ TEST(InputChecks, FramesWhoseTimeDoesNotGoForwardAreSkippedAndCounted)
 	ASSERT_EQ(traj.size(), 4u);
 	const double expected[] = {1.0, 2.0, 3.0, 4.0};
 	for (std::size_t i = 0; i < traj.size(); i++) EXPECT_NEAR(traj[i].t, expected[i], 1e-6);
+}
+
+TEST(InputChecks, ErrorsFromInsideMrptAreOneReadableLine)
+{
+	const std::string dir = test::scratchDir("input_checks_mrpt_errors");
+	{
+		core::RawlogWriter w(dir + "/one.rawlog");
+		w.write(core::makeRgbdObservation(texturedFrame(1.0)));
+		w.close();
+	}
+	const std::string tool = test::toolPath("keygrid-slam");
+	std::string out;
+	// A map plugin's option refused while MRPT's map factory builds it: MRPT wraps the reason
+	// in its exception text with a backtrace; the one line printed is the reason itself.
+	std::ofstream(dir + "/fine.ini") << "[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
+									 << "[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.001\n";
+	EXPECT_EQ(test::runCommand(tool + " --config " + dir + "/fine.ini --input " + dir + "/one.rawlog --output " + dir + "/out", &out), 1);
+	EXPECT_NE(out.find("keygrid-slam: error: MappingApplication_submappedOccupancyGrid3D_00_creationOpts/resolution = 0.001000: must be in [0.005000, 10.000000] m"),
+			  std::string::npos)
+		<< out;
+	EXPECT_EQ(out.find("0x"), std::string::npos) << "no backtrace address: " << out;
+	// A device is neither a rawlog nor a TUM folder.
+	EXPECT_EQ(test::runCommand(tool + " --config " + dir + "/fine.ini --input /dev/zero --output " + dir + "/out", &out), 1);
+	EXPECT_NE(out.find("input '/dev/zero' is neither a rawlog file nor a TUM folder"), std::string::npos) << out;
 }

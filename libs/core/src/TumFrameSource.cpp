@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <filesystem>
 #include <stdexcept>
 
 namespace keygrid::core
@@ -69,6 +70,9 @@ bool TumFrameSource::next(Frame& out)
 std::unique_ptr<FrameSource> openFrameSource(const std::string& path, const FrameSourceOptions& opts)
 {
 	if (mrpt::system::directoryExists(path)) return std::make_unique<TumFrameSource>(path, opts);
+	std::error_code ec;
+	if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+		throw std::runtime_error("input '" + path + "' is neither a rawlog file nor a TUM folder (a device or a pipe?)");
 	if (mrpt::system::fileExists(path)) return std::make_unique<RawlogFrameSource>(path);
 	throw std::runtime_error("input '" + path + "' does not exist");
 }

@@ -1,29 +1,40 @@
 #include <keygrid/core/CommandLine.h>
 #include <keygrid/slam/apps/AppRunner.h>
 
+#include <algorithm>
 #include <iostream>
+#include <string>
 
 namespace keygrid::slam
 {
 namespace
 {
+std::string lineStartingWith(const std::string& s, const std::string& prefix, bool* found)
+{
+	const auto at = s.find("\n" + prefix);
+	*found = at != std::string::npos;
+	if (!*found) return "";
+	const auto begin = at + 1 + prefix.size();
+	return s.substr(begin, s.find('\n', begin) - begin);
+}
+
+/** The reason of an error as one line. An MRPT exception reads "==== MRPT exception ====",
+ * "Message: ...", "Location: ...", then a backtrace. Wrapping a std::exception, MRPT cuts its
+ * text at the last ']': the part before it is printed as the Location, the rest as the
+ * Message; joined again they are the original reason. */
 std::string firstLine(const std::string& s)
 {
-	// MRPT exceptions carry a multi-line backtrace; the reason is the most specific line.
-	std::string best;
-	std::size_t start = 0;
-	while (start <= s.size())
-	{
-		auto end = s.find('\n', start);
-		if (end == std::string::npos) end = s.size();
-		std::string line = s.substr(start, end - start);
-		if (!line.empty() && line.find("==== MRPT exception") == std::string::npos)
-			best = line;  // MRPT puts the message last
-		if (best.empty()) best = line;
-		start = end + 1;
-		if (s.find("MRPT exception") == std::string::npos && !best.empty()) break;
-	}
-	return best.empty() ? s : best;
+	if (s.find("==== MRPT exception ====") == std::string::npos) return s.substr(0, s.find('\n'));
+	bool hasMessage = false, hasLocation = false;
+	std::string message = lineStartingWith(s, "Message:", &hasMessage);
+	std::string location = lineStartingWith(s, "Location:", &hasLocation);
+	if (!message.empty() && message[0] == ' ') message.erase(0, 1);
+	if (!location.empty() && location[0] == ' ') location.erase(0, 1);
+	const auto opened = std::count(location.begin(), location.end(), '['), closed = std::count(location.begin(), location.end(), ']');
+	if (hasLocation && opened > closed) return location + "]" + message;
+	if (!message.empty()) return message;
+	if (!location.empty()) return location;
+	return s.substr(0, s.find('\n'));
 }
 }  // namespace
 
