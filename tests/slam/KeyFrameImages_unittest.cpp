@@ -173,7 +173,7 @@ TEST(StoredKeyFrameImages, GivesBackTheSessionImagesDepthBitIdenticalInMetres)
 TEST(KeyFrameImageCache, CapacityIsTheStoreSectionsImageCacheMib)
 {
 	SessionRecorderOptions o;
-	EXPECT_EQ(o.imageCacheMib, 64);
+	EXPECT_EQ(o.imageCacheMib, 16);
 	mrpt::config::CConfigFileMemory c;
 	c.write("store", "image_cache_mib", 32);
 	o.loadFromConfigFile(c, "store");

@@ -238,7 +238,9 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 			m_waitingForMerge.push_back(job);
 		else
 			m_maps->insertKeyFrame(m_map, job.keyframe, job.travelled);
+		const auto t1 = std::chrono::steady_clock::now();
 		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+		m_timings.add("map_insertion:sync_landmarks", secondsSince(t1));
 		m_timings.add("map_insertion", secondsSince(t0));
 	}
 	const auto ev = closeLoops(job, tf);
