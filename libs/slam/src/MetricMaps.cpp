@@ -43,18 +43,18 @@ bool knownMapType(const std::string& name)
 }
 
 /** A depth-only observation of a keyframe, for MRPT's own maps. */
-mrpt::obs::CObservation3DRangeScan::Ptr depthObservation(const sfm::KeyFrame& kf)
+mrpt::obs::CObservation3DRangeScan::Ptr depthObservation(const sfm::KeyFrame& kf, const cv::Mat& depth)
 {
 	auto obs = mrpt::obs::CObservation3DRangeScan::Create();
 	const auto& cam = kf.features.camera;
 	obs->hasRangeImage = true;
 	obs->range_is_depth = true;
 	obs->rangeUnits = cam.depthUnits;
-	obs->rangeImage.resize(kf.depth.rows, kf.depth.cols);
-	for (int r = 0; r < kf.depth.rows; r++)
-		for (int c = 0; c < kf.depth.cols; c++)
+	obs->rangeImage.resize(depth.rows, depth.cols);
+	for (int r = 0; r < depth.rows; r++)
+		for (int c = 0; c < depth.cols; c++)
 		{
-			const double q = std::round(kf.depth.at<float>(r, c) / cam.depthUnits);
+			const double q = std::round(depth.at<float>(r, c) / cam.depthUnits);
 			obs->rangeImage(r, c) = q > 0 && q < 65535 ? static_cast<uint16_t>(q) : 0;
 		}
 	obs->cameraParams = cam.toTCamera();
@@ -188,15 +188,16 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 {
 	if (empty()) return;
 	const auto& kf = map.keyframe(id);
+	const cv::Mat depth = depthOf(kf);
 	m_insertedPoses[id] = kf.T_world_cam;
 	// The floor first, so that the keyframe enters the 2D grids in the newest floor frame.
 	// Samples of its depth image, else its map points.
 	if (!m_floor.given())
 	{
 		std::vector<mrpt::math::TPoint3Df> samples;
-		if (!kf.depth.empty())
+		if (!depth.empty())
 		{
-			const cv::Mat d = kf.depth.isContinuous() ? kf.depth : kf.depth.clone();
+			const cv::Mat d = depth.isContinuous() ? depth : depth.clone();
 			const auto& cam = kf.features.camera;
 			samples = maps::FloorFrameEstimator::depthSamples(d.ptr<float>(), d.rows, d.cols, cam.fx, cam.fy, cam.cx, cam.cy, m_floor.options());
 		}
@@ -216,7 +217,7 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 		auto& m = m_maps.maps[i];
 		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
 		{
-			if (m_feed.ism2dInput == "dense" && !kf.depth.empty())
+			if (m_feed.ism2dInput == "dense" && !depth.empty())
 			{
 				// Dense input is reduced in the floor frame: it waits for the floor.
 				auto& pending = m_pendingDense[i];
@@ -226,9 +227,13 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 					continue;
 				}
 				for (sfm::KeyFrameId p : pending)
-					if (map.hasKeyFrame(p)) ism->insertKeyframeDepth(p, map.keyframe(p).T_world_cam, *depthObservation(map.keyframe(p)));
+					if (map.hasKeyFrame(p))
+					{
+						const auto& pk = map.keyframe(p);
+						ism->insertKeyframeDepth(p, pk.T_world_cam, *depthObservation(pk, depthOf(pk)));
+					}
 				pending.clear();
-				if (!obs) obs = depthObservation(kf);
+				if (!obs) obs = depthObservation(kf, depth);
 				ism->insertKeyframeDepth(id, kf.T_world_cam, *obs);
 				continue;
 			}
@@ -244,16 +249,22 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 		}
 		else if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get()))
 		{
-			if (!kf.depth.empty()) g3->insertDepthFrame(kf.depth, kf.features.camera, kf.T_world_cam, travelled, id);
+			if (!depth.empty()) g3->insertDepthFrame(depth, kf.features.camera, kf.T_world_cam, travelled, id);
 		}
 		else if (dynamic_cast<CHOCPointsMap*>(m.get()))
 			continue;  // filled from the frontend's landmarks (syncLandmarks)
-		else if (!kf.depth.empty())
+		else if (!depth.empty())
 		{
-			if (!obs) obs = depthObservation(kf);
+			if (!obs) obs = depthObservation(kf, depth);
 			m->insertObservation(*obs, mrpt::poses::CPose3D(core::sensorPoseFromCameraPose(kf.T_world_cam)));
 		}
 	}
+}
+
+cv::Mat MetricMaps::depthOf(const sfm::KeyFrame& kf) const
+{
+	if (!kf.depth.empty() || !m_images) return kf.depth;
+	return m_images->load(kf).depth;
 }
 
 std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses)

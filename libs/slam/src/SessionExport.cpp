@@ -6,8 +6,8 @@
 #include <keygrid/slam/SessionExport.h>
 #include <keygrid/slam/SessionLoader.h>
 #include <keygrid/slam/SimpleMapExport.h>
+#include <keygrid/slam/StoredKeyFrameImages.h>
 #include <keygrid/slam/System.h>
-#include <keygrid/store/KeyFrameImageCodec.h>
 #include <keygrid/store/MapSnapshotCodec.h>
 #include <keygrid/store/SessionStore.h>
 
@@ -70,15 +70,8 @@ SessionExportResult exportSession(const std::string& file, const std::string& di
 		out.files.push_back("hoc_points.ply");
 	}
 
-	// The images, one keyframe at a time into the map (the simple map holds them all anyway).
-	for (const auto& [id, unused] : map.keyframes())
-	{
-		const auto img = session.loadImages(id);
-		auto& k = map.keyframe(id);
-		k.colour = img.colour;
-		if (!img.depthRaw.empty()) k.depth = store::KeyFrameImageCodec::rawToDepth(img.depthRaw, k.features.camera.depthUnits);
-	}
-	out.simpleMapEntries = writeKeyframesSimpleMap(map, dir + "/keyframes.simplemap");
+	// The images one keyframe at a time, from the file into keyframes.simplemap.
+	out.simpleMapEntries = writeKeyframesSimpleMap(map, StoredKeyFrameImages(session), dir + "/keyframes.simplemap");
 	out.files.push_back("keyframes.simplemap");
 	return out;
 }

@@ -88,6 +88,9 @@ void SessionRecorderOptions::loadFromConfigFile(const mrpt::config::CConfigFileB
 	images = c.read_bool(s, "images", images);
 	snapshotEvery = static_cast<int>(core::readFiniteNumber(c, s, "snapshot_every", snapshotEvery));
 	if (snapshotEvery < 0) throw std::invalid_argument("[" + s + "] snapshot_every = " + std::to_string(snapshotEvery) + " (must be >= 0)");
+	imageCacheMib = static_cast<int>(core::readFiniteNumber(c, s, "image_cache_mib", imageCacheMib));
+	if (imageCacheMib < 0 || imageCacheMib > (1 << 20))
+		throw std::invalid_argument("[" + s + "] image_cache_mib = " + std::to_string(imageCacheMib) + " (must be in [0, 1048576])");
 	newMapAfterLostFrames = static_cast<int>(core::readFiniteNumber(c, s, "new_map_after_lost_frames", newMapAfterLostFrames));
 	if (newMapAfterLostFrames < 0)
 		throw std::invalid_argument("[" + s + "] new_map_after_lost_frames = " + std::to_string(newMapAfterLostFrames) + " (must be >= 0)");
@@ -99,6 +102,7 @@ void SessionRecorderOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, 
 {
 	c.write(s, "images", images, 30, 40, "store each keyframe's colour and depth images");
 	c.write(s, "snapshot_every", snapshotEvery, 30, 40, "metric-map snapshots every N keyframes (0: at the end only)");
+	c.write(s, "image_cache_mib", imageCacheMib, 30, 40, "RAM for keyframe images out of their keyframes [MiB] (the rest in a spill file)");
 	c.write(s, "new_map_after_lost_frames", newMapAfterLostFrames, 30, 40, "extend mode: lost frames at the start before a new map begins (0: never)");
 	sqlite.saveToConfigFile(c, s);
 	codec.saveToConfigFile(c, s);

@@ -24,7 +24,8 @@ System::System(const SlamConfig& cfg)
 	: m_cfg(cfg),
 	  m_extractor(cfg.features),
 	  m_tracker(m_map, cfg.tracker),
-	  m_mapper(m_map, cfg.mapping, cfg.tracker.matcher)
+	  m_mapper(m_map, cfg.mapping, cfg.tracker.matcher),
+	  m_images(std::make_unique<KeyFrameImageCache>(static_cast<std::size_t>(cfg.store.imageCacheMib) << 20))
 {
 	if (cfg.loop.enabled)
 	{
@@ -105,6 +106,19 @@ void System::reintegrateLoadedKeyFrames(const store::SessionStore& session)
 		m_maps->insertKeyFrame(m_map, id, m_travelled);
 	}
 	if (m_maps) m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+	releaseKeyFrameImages();
+}
+
+void System::releaseKeyFrameImages()
+{
+	for (auto& [id, kf] : m_map.keyframes())
+	{
+		if (kf.mapId != 0 || (kf.depth.empty() && kf.colour.empty())) continue;
+		m_images->put(id, {kf.depth, kf.colour});
+		auto& k = m_map.keyframe(id);
+		k.depth.release();
+		k.colour.release();
+	}
 }
 
 sfm::FrameFeatures System::extract(const core::Frame& frame) const { return m_extractor.extract(frame); }
@@ -224,7 +238,9 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 			m_waitingForMerge.push_back(job);
 		else
 			m_maps->insertKeyFrame(m_map, job.keyframe, job.travelled);
+		const auto t1 = std::chrono::steady_clock::now();
 		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+		m_timings.add("map_insertion:sync_landmarks", secondsSince(t1));
 		m_timings.add("map_insertion", secondsSince(t0));
 	}
 	const auto ev = closeLoops(job, tf);
@@ -250,6 +266,11 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 		noteRunAttributes();
 		m_recorder->afterKeyFrame(m_map, m_loopCloser.get(), ev ? &*ev : nullptr, m_maps.get());
 		m_timings.add("session_store", secondsSince(t0));
+	}
+	{
+		const auto t0 = std::chrono::steady_clock::now();
+		releaseKeyFrameImages();
+		m_timings.add("image_spill", secondsSince(t0));
 	}
 	if (!ev) return;
 	std::lock_guard<std::mutex> lk(m_statsMutex);

@@ -17,7 +17,7 @@
 # Timings depend on the machine's load: run it on an idle machine, or with `nice` beside others.
 #
 #   tests/benchmarks/slam/office_loop_memory.sh [--build DIR] [--out DIR] [--sim DIR]
-#       [--set 'SECTION.KEY=V; ...'] [--tag NAME] [--max-frames N] [--header]
+#       [--set 'SECTION.KEY=V; ...'] [--tag NAME] [--max-frames N] [--map] [--header]
 #
 #   --build DIR        build tree with bin/keygrid-slam (and bin/keygrid-sim to render) (default: build)
 #   --out DIR          the run goes to DIR/run_<tag> (redone every time); renders to DIR/sim when
@@ -29,6 +29,7 @@
 #                      (default: none)
 #   --tag NAME         name of the run folder and of the table row (default: the build folder's name)
 #   --max-frames N     stop after N frames (default: all 3300)
+#   --map              also record the run into a session file (keygrid-slam --map RUN/session.kgmap)
 #   --header           print the table header before the row
 set -uo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
@@ -40,11 +41,13 @@ extraSet=""
 tag=""
 maxFrames=0
 header=0
+withMap=0
 die() { echo "office_loop_memory.sh: error: $*" >&2; exit 2; }
 while [ $# -gt 0 ]; do
   case "$1" in
     --help|-h) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     --header) header=1; shift; continue ;;
+    --map) withMap=1; shift; continue ;;
   esac
   [ $# -ge 2 ] || die "missing value after $1"
   case "$1" in
@@ -84,6 +87,7 @@ rm -rf "$run"; mkdir -p "$run"
 overrides="slam.mode=sequential"
 [ -n "$extraSet" ] && overrides="$overrides; $extraSet"
 extra=(); [ "$maxFrames" -gt 0 ] && extra=(--max-frames "$maxFrames")
+[ "$withMap" = 1 ] && extra+=(--map "$run/session.kgmap")
 echo "== office_loop, $tag: keygrid-slam -> $run" >&2
 "$build/bin/keygrid-slam" --quiet --config "$root/config/sim.ini" --input "$sim/tum" --output "$run" \
   --gt "$sim/groundtruth.txt" --set "$overrides" "${extra[@]}" >"$run/slam.log" 2>&1 \

@@ -353,7 +353,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	try
 	{
 		// A loaded map's keyframes have their images in the session file, not here.
-		if (!sys.localizeOnly()) writeKeyframesSimpleMap(sys.map(), o.output + "/keyframes.simplemap");
+		if (!sys.localizeOnly()) writeKeyframesSimpleMap(sys.map(), sys.keyFrameImages(), o.output + "/keyframes.simplemap");
 	}
 	catch (const std::exception& e)
 	{

@@ -20,6 +20,7 @@
 #include <keygrid/maps/CHOCPointsMap.h>
 #include <keygrid/maps/FloorFrameEstimator.h>
 #include <keygrid/sfm/SparseMap.h>
+#include <keygrid/slam/KeyFrameImageSource.h>
 #include <mrpt/maps/CMultiMetricMap.h>
 
 #include <map>
@@ -73,6 +74,10 @@ class MetricMaps
 	 * camera's path length so far [m]. */
 	void insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId kf, double travelled);
 
+	/** Where the depth of a keyframe that no longer holds it comes from (a keyframe waiting
+	 * for the floor, see m_pendingDense, or inserted after its images left RAM); null: the
+	 * keyframe's own. Not owned; must outlive the maps' use of it. */
+	void setImageSource(const KeyFrameImageSource* images) { m_images = images; }
 	/** Re-anchors the maps on corrected keyframe poses (kf id -> new T_world_cam): the floor
 	 * is re-estimated under them, the 2D grid is rebuilt from its stored keyframe
 	 * observations, the 3D grid morphed and merged.
@@ -111,6 +116,9 @@ class MetricMaps
 	/** Dense 2D input, per map index: keyframes that arrived before the floor was known. */
 	std::map<std::size_t, std::vector<sfm::KeyFrameId>> m_pendingDense;
 
+	const KeyFrameImageSource* m_images{nullptr};
+	/** The keyframe's depth, from m_images when the keyframe dropped it. */
+	cv::Mat depthOf(const sfm::KeyFrame& kf) const;
 	/** Hands a new floor frame to every 2D grid and re-integrates those that hold keyframes. */
 	void floorChanged();
 	/** The frame map outputs are written in: the floor frame, else the SLAM world. */

@@ -36,6 +36,10 @@ struct SessionRecorderOptions
 	/** Store each keyframe's colour and depth images (needed to rebuild the dense maps and for
 	 * keyframes.simplemap of an exported session) (Default: true) */
 	bool images{true};
+	/** RAM for keyframe images that left their keyframes (KeyFrameImageCache: the most
+	 * recently used; all of them are in a spill file in $TMPDIR) [MiB], with or without a
+	 * session file; 0 = none kept in RAM (Default: 16) */
+	int imageCacheMib{16};
 	/** Snapshot of the metric maps every this many keyframes, and always at the end; 0 = at
 	 * the end only (Default: 25) */
 	int snapshotEvery{25};

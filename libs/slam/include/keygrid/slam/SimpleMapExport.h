@@ -10,25 +10,39 @@
  * intrinsics). MRPT's convention: the entry's pose is the robot pose and the observation's
  * sensorPose is relative to it. keygrid stores the sensor pose itself as the robot pose,
  * T_world_depth = core::sensorPoseFromCameraPose(T_world_cam), with sensorPose = identity.
+ *
+ * The file is written streaming (writeKeyframesSimpleMap): one keyframe's images at a time are
+ * loaded and serialized, the bytes being those CSimpleMap's own serialization gives.
  */
 #include <keygrid/sfm/SparseMap.h>
+#include <keygrid/slam/KeyFrameImageSource.h>
 #include <mrpt/maps/CSimpleMap.h>
+#include <mrpt/serialization/CArchive.h>
 #include <mrpt/serialization/CSerializable.h>
 
+#include <functional>
 #include <string>
 
 namespace keygrid::slam
 {
-/** Builds the simple map of all keyframes of `map` that have depth and an image. The pose
+/** The simple map entry of keyframe `kf` with its images `img` (both non-empty). The pose
  * covariance is zero: the SLAM system does not estimate marginal covariances. */
-mrpt::maps::CSimpleMap keyframesSimpleMap(const sfm::SparseMap& map);
+mrpt::maps::CSimpleMap::Pair keyframeSimpleMapEntry(const sfm::KeyFrame& kf, const KeyFrameImageData& img);
 
-/** Serializes `obj` gz-compressed (as MRPT's tools expect for .simplemap, .3Dscene, ...) to
- * `path` atomically: written to `<path>.tmp`, then renamed. Throws std::runtime_error naming
- * the path on failure. */
+/** Builds, in RAM, the simple map of all keyframes of `map` that have depth and an image in
+ * `images`. */
+mrpt::maps::CSimpleMap keyframesSimpleMap(const sfm::SparseMap& map, const KeyFrameImageSource& images = KeyFrameImagesInRam());
+
+/** Writes gz-compressed (as MRPT's tools expect for .simplemap, .3Dscene, ...) to `path`
+ * atomically: `write` fills `<path>.tmp`, which is then renamed. Throws std::runtime_error
+ * naming the path on failure (the .tmp is removed). */
+void writeGzAtomically(const std::string& path, const std::function<void(mrpt::serialization::CArchive&)>& write);
+
+/** Serializes `obj` with writeGzAtomically. */
 void saveGzAtomically(const mrpt::serialization::CSerializable& obj, const std::string& path);
 
-/** keyframesSimpleMap(map) saved with saveGzAtomically. Returns the number of entries. */
-std::size_t writeKeyframesSimpleMap(const sfm::SparseMap& map, const std::string& path);
+/** Writes keyframesSimpleMap(map, images) to `path` (as saveGzAtomically would, byte for byte)
+ * with the images of one keyframe at a time in RAM. Returns the number of entries. */
+std::size_t writeKeyframesSimpleMap(const sfm::SparseMap& map, const KeyFrameImageSource& images, const std::string& path);
 
 }  // namespace keygrid::slam

@@ -17,6 +17,7 @@
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/slam/LoopCloser.h>
+#include <keygrid/slam/KeyFrameImageCache.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SessionLoader.h>
 #include <keygrid/slam/SessionRecorder.h>
@@ -77,7 +78,11 @@ class System
 	const sfm::TrackedFrame& process(const core::Frame& frame);
 
 	/** Maps fed with every keyframe (optional; see MetricMaps). */
-	void attachMaps(std::unique_ptr<MetricMaps> maps) { m_maps = std::move(maps); }
+	void attachMaps(std::unique_ptr<MetricMaps> maps)
+	{
+		m_maps = std::move(maps);
+		if (m_maps) m_maps->setImageSource(m_images.get());
+	}
 	const MetricMaps* metricMaps() const { return m_maps.get(); }
 
 	/** Records the run into a session file (keygrid-slam --map): each keyframe after its local
@@ -120,6 +125,10 @@ class System
 	/** The map; in threaded mode only after finish() (while the threads run, use
 	 * numKeyFrames()). */
 	const sfm::SparseMap& map() const { return m_map; }
+	/** The keyframes' images (keyframes.simplemap): a keyframe drops its own once it is in the
+	 * metric maps and the session file; they are kept in a KeyFrameImageCache
+	 * ([store] image_cache_mib) over a spill file in $TMPDIR. */
+	const KeyFrameImageCache& keyFrameImages() const { return *m_images; }
 	/** Keyframes in the map now (takes the map lock: safe while the threads run). */
 	std::size_t numKeyFrames() const;
 	const std::vector<sfm::TrackedFrame>& frames() const { return m_frames; }
@@ -155,6 +164,9 @@ class System
 	/** Extend mode, the stored map loaded: its keyframes into the metric maps (images from the
 	 * session file), and the camera path length it ends with. */
 	void reintegrateLoadedKeyFrames(const store::SessionStore& session);
+	/** Moves the images of the keyframes of map 0 (in the metric maps and handed to the
+	 * recorder) into m_images; a keyframe of a map not merged yet keeps its own until it is. */
+	void releaseKeyFrameImages();
 	/** Extend mode, until the camera relocalized in the stored map or a new map was started
 	 * (map lock held). */
 	void startExtending(const sfm::TrackedFrame& tf);
@@ -181,6 +193,7 @@ class System
 	std::vector<std::optional<mrpt::poses::CPose3D>> m_refined;
 	std::optional<sfm::PinholeIntrinsics> m_K;
 	bool m_finished{false};
+	std::unique_ptr<KeyFrameImageCache> m_images;
 	std::unique_ptr<MetricMaps> m_maps;
 	std::unique_ptr<SessionRecorder> m_recorder;
 	bool m_localizeOnly{false};
