@@ -2,11 +2,13 @@
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
+#include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SimpleMapExport.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/maps/TMetricMapTypesRegistry.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <regex>
@@ -90,6 +92,25 @@ CHOCPointsMap hocPointsFromLandmarks(const sfm::SparseMap& map, const maps::HocO
 
 namespace
 {
+/** A keygrid plugin's option section holds only keys its map definition reads (those
+ * IniReference records); MRPT's own maps are left to MRPT. */
+void checkPluginKeys(const mrpt::config::CConfigFileBase& cfg, const std::string& section, const std::string& type, const std::string& group)
+{
+	static const auto plugins = keygridMapPluginNames();
+	if (std::find(plugins.begin(), plugins.end(), type) == plugins.end()) return;
+	const auto reference = mapPluginReference(type);
+	if (!reference) return;
+	const std::string refName = std::string(MetricMaps::kSection) + "_" + type + "_00_" + group;
+	const auto ref = std::find_if(reference->begin(), reference->end(), [&](const IniSection& r) { return r.name == refName; });
+	if (ref == reference->end())
+		throw std::invalid_argument("[" + section + "]: map type '" + type + "' reads no " + group + " (doc/ini-reference.md)");
+	std::vector<std::string> keys;
+	cfg.getAllKeys(section, keys);
+	for (const auto& k : keys)
+		if (std::none_of(ref->keys.begin(), ref->keys.end(), [&](const IniKey& r) { return r.key == k; }))
+			throw std::invalid_argument("[" + section + "] " + k + ": unknown key (typo? doc/ini-reference.md lists the keys of " + type + ")");
+}
+
 /** Every [MappingApplication_<type>_<NN>_<group>] section belongs to a configured map
  * (<type>_count > NN) and is an option group MRPT's maps read; a misspelt one would be
  * ignored with all its keys. */
@@ -115,6 +136,7 @@ void checkMapSections(const mrpt::config::CConfigFileBase& cfg, const std::map<s
 		if (!groups.count(m[3].str()))
 			throw std::invalid_argument(
 				"[" + name + "]: unknown option group '" + m[3].str() + "' (creationOpts, insertOpts, likelihoodOpts, renderOpts, colorOpts)");
+		checkPluginKeys(cfg, name, m[1].str(), m[3].str());
 	}
 }
 }  // namespace
