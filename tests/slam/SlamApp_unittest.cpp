@@ -272,8 +272,10 @@ TEST(SlamApp, MapSectionsThatNoMapReadsAreNamed)
 	EXPECT_EQ(errorOf(maps + "[MappingApplication_ismOccupancyGrid2D_00_insertOpts]\nmaxRange = 4\n"), "");
 	EXPECT_NE(errorOf("[MappingApplication]\nismOccupancyGrid2D_count = one\n").find("ismOccupancyGrid2D_count = 'one' is not a whole number"), std::string::npos);
 	EXPECT_NE(errorOf(maps + "[MappingApplication_ismOccupancyGrid2D_00_insertOpt]\nmaxRange = 4\n").find("unknown option group 'insertOpt'"), std::string::npos);
-	EXPECT_NE(errorOf(maps + "[MappingApplication_ismOccupancyGrid2D_01_insertOpts]\nmaxRange = 4\n").find("no map 01 of type 'ismOccupancyGrid2D'"), std::string::npos);
-	EXPECT_NE(errorOf(maps + "[MappingApplication_ismOccupancyGrid_00_insertOpts]\nmaxRange = 4\n").find("no map 00 of type 'ismOccupancyGrid'"), std::string::npos);
+	// A map switched off keeps its options (count 0, or fewer maps than sections).
+	EXPECT_EQ(errorOf(maps + "[MappingApplication_ismOccupancyGrid2D_01_insertOpts]\nmaxRange = 4\n"), "");
+	EXPECT_EQ(errorOf("[MappingApplication]\nismOccupancyGrid2D_count = 0\n[MappingApplication_ismOccupancyGrid2D_00_insertOpts]\nmaxRange = 4\n"), "");
+	EXPECT_NE(errorOf(maps + "[MappingApplication_ismOccupancyGrid_00_insertOpts]\nmaxRange = 4\n").find("no map type 'ismOccupancyGrid'"), std::string::npos);
 	// A keygrid plugin's keys: a typo is named.
 	EXPECT_NE(errorOf(maps + "[MappingApplication_ismOccupancyGrid2D_00_insertOpts]\nmaxRang = 4\n").find("maxRang: unknown key"), std::string::npos);
 }

@@ -111,8 +111,8 @@ void checkPluginKeys(const mrpt::config::CConfigFileBase& cfg, const std::string
 			throw std::invalid_argument("[" + section + "] " + k + ": unknown key (typo? doc/ini-reference.md lists the keys of " + type + ")");
 }
 
-/** Every [MappingApplication_<type>_<NN>_<group>] section belongs to a configured map
- * (<type>_count > NN) and is an option group MRPT's maps read; a misspelt one would be
+/** Every [MappingApplication_<type>_<NN>_<group>] section names a map type that is
+ * configured or registered and an option group MRPT's maps read; a misspelt one would be
  * ignored with all its keys. */
 void checkMapSections(const mrpt::config::CConfigFileBase& cfg, const std::map<std::string, int>& counts)
 {
@@ -127,12 +127,12 @@ void checkMapSections(const mrpt::config::CConfigFileBase& cfg, const std::map<s
 		std::smatch m;
 		if (!std::regex_match(name, m, pattern))
 			throw std::invalid_argument("[" + name + "]: not a map option section (expected " + prefix + "<type>_<NN>_<group>)");
-		const auto c = counts.find(m[1].str());
-		const int index = std::stoi(m[2].str());
-		if (c == counts.end() || index >= c->second)
+		// A map switched off (<type>_count = 0, or fewer maps than sections) keeps its options;
+		// a type that is neither configured nor registered is a typo.
+		if (!counts.count(m[1].str()) && !knownMapType(m[1].str()))
 			throw std::invalid_argument(
-				"[" + name + "]: no map " + m[2].str() + " of type '" + m[1].str() + "' is configured ([" +
-				MetricMaps::kSection + "] " + m[1].str() + "_count = " + (c == counts.end() ? std::string("(none)") : std::to_string(c->second)) + ")");
+				"[" + name + "]: no map type '" + m[1].str() + "' is configured in [" + MetricMaps::kSection +
+				"] or registered (typo?)");
 		if (!groups.count(m[3].str()))
 			throw std::invalid_argument(
 				"[" + name + "]: unknown option group '" + m[3].str() + "' (creationOpts, insertOpts, likelihoodOpts, renderOpts, colorOpts)");
