@@ -1,10 +1,9 @@
 #include <keygrid/maps/ExportFrame.h>
 #include <keygrid/sfm/BundleWindow.h>
 #include <keygrid/slam/FinalRefinement.h>
+#include <keygrid/slam/StoredKeyFrameImages.h>
 #include <keygrid/slam/System.h>
-#include <keygrid/store/KeyFrameImageCodec.h>
 
-#include <algorithm>
 #include <chrono>
 #include <cstdlib>
 #include <set>
@@ -91,6 +90,7 @@ void System::reintegrateLoadedKeyFrames(const store::SessionStore& session)
 {
 	// The camera path goes on from the stored run's (the 3D grid compares voxels by the path
 	// length at which they were seen): along the keyframes, in the order they were made.
+	const StoredKeyFrameImages stored(session);
 	std::optional<Eigen::Vector3d> last;
 	for (auto& [id, kf] : m_map.keyframes())
 	{
@@ -99,10 +99,10 @@ void System::reintegrateLoadedKeyFrames(const store::SessionStore& session)
 		last = c;
 		if (!m_maps) continue;
 		// The images come back for the dense maps and keyframes.simplemap.
-		const auto img = session.loadImages(id);
+		auto img = stored.load(kf);
 		auto& k = m_map.keyframe(id);
-		k.colour = img.colour;
-		if (!img.depthRaw.empty()) k.depth = store::KeyFrameImageCodec::rawToDepth(img.depthRaw, k.features.camera.depthUnits);
+		k.colour = std::move(img.colour);
+		k.depth = std::move(img.depth);
 		m_maps->insertKeyFrame(m_map, id, m_travelled);
 	}
 	if (m_maps) m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
@@ -247,11 +247,17 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 	if (ev && ev->mergedMap && m_maps)
 	{
 		const auto t0 = std::chrono::steady_clock::now();
+		// The merged keyframes go in (culled ones are dropped); another map's keep waiting.
+		std::vector<KeyFrameJob> stillWaiting;
 		for (const auto& w : m_waitingForMerge)
-			if (m_map.hasKeyFrame(w.keyframe) && m_map.keyframe(w.keyframe).mapId == 0) m_maps->insertKeyFrame(m_map, w.keyframe, w.travelled);
-		m_waitingForMerge.erase(
-			std::remove_if(m_waitingForMerge.begin(), m_waitingForMerge.end(), [&](const KeyFrameJob& w) { return !m_map.hasKeyFrame(w.keyframe) || m_map.keyframe(w.keyframe).mapId == 0; }),
-			m_waitingForMerge.end());
+		{
+			if (!m_map.hasKeyFrame(w.keyframe)) continue;
+			if (m_map.keyframe(w.keyframe).mapId == 0)
+				m_maps->insertKeyFrame(m_map, w.keyframe, w.travelled);
+			else
+				stillWaiting.push_back(w);
+		}
+		m_waitingForMerge.swap(stillWaiting);
 		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 		m_timings.add("map_insertion", secondsSince(t0));
 	}
