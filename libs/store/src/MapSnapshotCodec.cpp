@@ -1,6 +1,6 @@
+#include <keygrid/store/GzipBlock.h>
 #include <keygrid/store/MapSnapshotCodec.h>
 #include <mrpt/io/CMemoryStream.h>
-#include <mrpt/io/zip.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include <fstream>
@@ -8,6 +8,13 @@
 
 namespace keygrid::store
 {
+namespace
+{
+// A serialized map over 16 GiB cannot be a snapshot keygrid wrote on a 24 GB machine; the bound
+// keeps a damaged length from claiming all memory.
+constexpr std::size_t kMaxSnapshotBytes = std::size_t{16} << 30;
+}  // namespace
+
 MapSnapshot MapSnapshotCodec::encode(
 	const std::string& name, const mrpt::serialization::CSerializable& map, KeyFrameId lastKeyFrame, int gzLevel)
 {
@@ -20,16 +27,21 @@ MapSnapshot MapSnapshotCodec::encode(
 	MapSnapshot s;
 	s.name = name;
 	s.lastKeyFrame = lastKeyFrame;
-	if (!mrpt::io::zip::compress_gz_data_block(raw, s.data, gzLevel))
-		throw std::runtime_error("MapSnapshotCodec::encode: gz compression of snapshot '" + name + "' failed");
+	s.data = gzipCompress(raw, gzLevel);
 	return s;
 }
 
 mrpt::serialization::CSerializable::Ptr MapSnapshotCodec::decode(const MapSnapshot& snapshot)
 {
 	std::vector<std::uint8_t> raw;
-	if (!mrpt::io::zip::decompress_gz_data_block(snapshot.data, raw))
-		throw std::runtime_error("map snapshot '" + snapshot.name + "': the data is not gz-compressed");
+	try
+	{
+		raw = gzipDecompress(snapshot.data, kMaxSnapshotBytes);
+	}
+	catch (const std::exception& e)
+	{
+		throw std::runtime_error("map snapshot '" + snapshot.name + "': " + e.what());
+	}
 	mrpt::io::CMemoryStream mem;
 	mem.assignMemoryNotOwn(raw.data(), raw.size());
 	try
