@@ -125,6 +125,38 @@ TEST(Robustness, TruncatedRawlogKeepsTheFramesBeforeTheCut)
 	}
 }
 
+// A damaged range image size (the high byte of an entry's cols) would make MRPT write through
+// a null allocation: it is named before MRPT reads it, and the earlier frames' outputs stay.
+TEST(Robustness, DamagedRangeImageSizeIsNamedAndTheEarlierFramesKept)
+{
+	const std::string dir = test::scratchDir("robust_range_size");
+	const std::string cfg = test::writeFastConfig(dir + "/fast.ini");
+	const std::string rawlog = dir + "/damaged.rawlog";
+	test::writeRawlog(rawlog, {tinyObservation(0), tinyObservation(1), tinyObservation(2)});
+	std::string bytes = readBytes(rawlog);
+	// The third entry's range image size: the first (rows, cols) = (30, 40) after its class name.
+	std::size_t at = 0;
+	for (int k = 0; k < 3; k++) at = bytes.find("mrpt::obs::CObservation3DRangeScan", at + 1);
+	ASSERT_NE(at, std::string::npos);
+	at = bytes.find(std::string("\x1e\0\0\0\x28\0\0\0", 8), at);
+	ASSERT_NE(at, std::string::npos);
+	bytes[at + 7] = '\x7f';
+	writeBytes(rawlog, bytes);
+
+	const ToolRun r = test::runTool("keygrid-slam", slamArgs(cfg, rawlog, dir + "/out"));
+	EXPECT_EXITED(r);
+	EXPECT_EQ(r.exitCode(), 1) << r.output;
+	EXPECT_NE(r.output.find("keygrid-slam: error: rawlog '" + rawlog + "' is corrupt at entry 2 (byte "), std::string::npos) << r.output;
+	EXPECT_NE(r.output.find("range image of 2130706472 x 30 pixels"), std::string::npos) << r.output;
+	EXPECT_EQ(test::countPoseLines(dir + "/out/trajectory.txt"), 2u) << r.output;
+
+	const ToolRun v = test::runTool("keygrid-vocab", "train --rawlog " + rawlog + " --output " + dir + "/v.voc");
+	EXPECT_EXITED(v);
+	EXPECT_EQ(v.exitCode(), 1) << v.output;
+	EXPECT_NE(v.output.find("is corrupt at entry 2"), std::string::npos) << v.output;
+	EXPECT_FALSE(mrpt::system::fileExists(dir + "/v.voc"));
+}
+
 TEST(Robustness, ObservationsWithoutDepthImageOrValidCalibrationAreSkippedAndCounted)
 {
 	const std::string dir = test::scratchDir("robust_skips");

@@ -1,3 +1,4 @@
+#include <keygrid/core/RawlogEntryCheck.h>
 #include <keygrid/core/RawlogFrameSource.h>
 #include <keygrid/core/RgbdObservation.h>
 #include <mrpt/img/CImage.h>
@@ -107,9 +108,23 @@ bool RawlogFrameSource::next(Frame& out)
 		// which reports a truncated or corrupt file as a normal end of file.
 		mrpt::serialization::CSerializable::Ptr obj;
 		const std::size_t posBefore = m_impl->file.getPosition();
+		// The sizes the entry declares are checked before MRPT allocates from them
+		// (RawlogEntryCheck.h); the bytes read for that are replayed to the deserializer.
+		std::vector<std::uint8_t> head;
+		RawlogEntryLimits limits;
+		if (!m_compressed) limits.bytesLeft = m_fileSize > posBefore ? m_fileSize - posBefore : 0;
+		const std::string damaged = checkRawlogEntry(m_impl->file, head, limits);
+		if (!damaged.empty())
+		{
+			m_impl->eof = true;
+			throw std::runtime_error(
+				"rawlog '" + m_path + "' is corrupt at entry " + std::to_string(m_impl->entry) + " (byte " +
+				std::to_string(posBefore) + "): " + damaged);
+		}
 		try
 		{
-			auto arch = mrpt::serialization::archiveFrom(m_impl->file);
+			PrefixedStream entry(head, m_impl->file);
+			auto arch = mrpt::serialization::archiveFrom(entry);
 			obj = arch.ReadObject();
 		}
 		catch (const mrpt::serialization::CExceptionEOF&)

@@ -1,0 +1,143 @@
+#include <keygrid/core/RawlogEntryCheck.h>
+
+#include <cstring>
+#include <optional>
+#include <stdexcept>
+
+namespace keygrid::core
+{
+namespace
+{
+/** Little-endian reads from a stream, recording every byte; nullopt on a short read. */
+class Reader
+{
+   public:
+	Reader(mrpt::io::CStream& in, std::vector<std::uint8_t>& consumed) : m_in(in), m_consumed(consumed) {}
+
+	bool bytes(std::size_t n)
+	{
+		const std::size_t at = m_consumed.size();
+		m_consumed.resize(at + n);
+		const std::size_t got = n ? m_in.Read(m_consumed.data() + at, n) : 0;
+		m_consumed.resize(at + got);
+		return got == n;
+	}
+	template <typename T>
+	std::optional<T> value()
+	{
+		if (!bytes(sizeof(T))) return std::nullopt;
+		T v;
+		std::memcpy(&v, m_consumed.data() + m_consumed.size() - sizeof(T), sizeof(T));
+		return v;  // MRPT writes little-endian; keygrid builds for little-endian hosts only
+	}
+	/** An object header in MRPT 2's format: (0x80 | name length), class name, version. */
+	std::optional<std::pair<std::string, std::uint8_t>> header()
+	{
+		const auto b = value<std::uint8_t>();
+		if (!b || !(*b & 0x80)) return std::nullopt;  // older formats: not walked
+		const std::size_t n = *b & 0x7F;
+		if (!bytes(n)) return std::nullopt;
+		std::string name(reinterpret_cast<const char*>(m_consumed.data() + m_consumed.size() - n), n);
+		const auto version = value<std::uint8_t>();
+		if (!version) return std::nullopt;
+		return std::make_pair(name, *version);
+	}
+	std::size_t count() const { return m_consumed.size(); }
+
+   private:
+	mrpt::io::CStream& m_in;
+	std::vector<std::uint8_t>& m_consumed;
+};
+
+bool isClass(const std::string& name, const char* ns, const char* cls)
+{
+	return name == cls || name == std::string(ns) + "::" + cls;
+}
+
+/** Bytes still available after what `r` consumed, from the entry's own start `start`. */
+std::uint64_t left(const RawlogEntryLimits& l, const Reader& r, std::size_t start)
+{
+	const std::uint64_t used = r.count() - start;
+	return l.bytesLeft > used ? l.bytesLeft - used : 0;
+}
+
+// CObservation3DRangeScan (versions 9, 10) up to its range image size:
+//   float maxRange, CPose3D sensorPose (an object: header, 12 doubles, end byte 0x88),
+//   bool hasPoints3D [uint32 N, 3 x N float, 2 x N uint16], bool hasRangeImage,
+//   float rangeUnits [uint32 rows, uint32 cols, rows x cols uint16].
+std::string checkRangeScan(Reader& r, std::uint8_t version, const RawlogEntryLimits& l, std::size_t start)
+{
+	if (version < 9 || version > 10) return {};
+	if (!r.value<float>()) return {};
+	const auto pose = r.header();
+	if (!pose || !isClass(pose->first, "mrpt::poses", "CPose3D") || pose->second != 3) return {};
+	if (!r.bytes(12 * sizeof(double))) return {};
+	const auto end = r.value<std::uint8_t>();
+	if (!end || *end != 0x88) return {};
+	const auto hasPoints = r.value<std::uint8_t>();
+	if (!hasPoints) return {};
+	if (*hasPoints)
+	{
+		const auto n = r.value<std::uint32_t>();
+		if (!n) return {};
+		const std::uint64_t bytes = std::uint64_t{*n} * (3 * sizeof(float) + 2 * sizeof(std::uint16_t));
+		if (bytes > left(l, r, start))
+			return "CObservation3DRangeScan declares " + std::to_string(*n) + " 3D points (" + std::to_string(bytes) +
+				   " bytes), more than the " + std::to_string(left(l, r, start)) + " bytes left in the file";
+		if (!r.bytes(static_cast<std::size_t>(bytes))) return {};
+	}
+	const auto hasRange = r.value<std::uint8_t>();
+	if (!hasRange || !r.value<float>() || !*hasRange) return {};
+	const auto rows = r.value<std::uint32_t>();
+	const auto cols = rows ? r.value<std::uint32_t>() : std::nullopt;
+	if (!rows || !cols) return {};
+	const std::string size = std::to_string(*cols) + " x " + std::to_string(*rows);
+	if (*rows > l.maxImageSide || *cols > l.maxImageSide)
+		return "CObservation3DRangeScan range image of " + size + " pixels (a side over " + std::to_string(l.maxImageSide) + ")";
+	const std::uint64_t bytes = std::uint64_t{*rows} * *cols * sizeof(std::uint16_t);
+	if (bytes > left(l, r, start))
+		return "CObservation3DRangeScan range image of " + size + " pixels needs " + std::to_string(bytes) +
+			   " bytes, more than the " + std::to_string(left(l, r, start)) + " bytes left in the file";
+	return {};
+}
+}  // namespace
+
+std::string checkRawlogEntry(mrpt::io::CStream& in, std::vector<std::uint8_t>& consumed, const RawlogEntryLimits& limits)
+{
+	Reader r(in, consumed);
+	const std::size_t start = r.count();
+	const auto h = r.header();
+	if (!h) return {};
+	if (isClass(h->first, "mrpt::obs", "CObservation3DRangeScan")) return checkRangeScan(r, h->second, limits, start);
+	// CSensoryFrame (version 2): uint32 count, then the observations as objects.
+	if (isClass(h->first, "mrpt::obs", "CSensoryFrame") && h->second == 2)
+	{
+		const auto n = r.value<std::uint32_t>();
+		if (!n || *n == 0) return {};
+		if (*n > left(limits, r, start))
+			return "CSensoryFrame declares " + std::to_string(*n) + " observations, more than the " +
+				   std::to_string(left(limits, r, start)) + " bytes left in the file";
+		const auto first = r.header();
+		if (first && isClass(first->first, "mrpt::obs", "CObservation3DRangeScan"))
+			return checkRangeScan(r, first->second, limits, start);
+	}
+	return {};
+}
+
+size_t PrefixedStream::Read(void* buf, size_t n)
+{
+	auto* out = static_cast<std::uint8_t*>(buf);
+	const std::size_t fromPrefix = std::min(n, m_prefix.size() - m_offset);
+	if (fromPrefix) std::memcpy(out, m_prefix.data() + m_offset, fromPrefix);
+	m_offset += fromPrefix;
+	return fromPrefix + (n > fromPrefix ? m_rest.Read(out + fromPrefix, n - fromPrefix) : 0);
+}
+
+size_t PrefixedStream::Write(const void*, size_t) { throw std::logic_error("PrefixedStream is read-only"); }
+
+uint64_t PrefixedStream::Seek(int64_t, mrpt::io::CStream::TSeekOrigin)
+{
+	throw std::logic_error("PrefixedStream cannot seek");
+}
+
+}  // namespace keygrid::core

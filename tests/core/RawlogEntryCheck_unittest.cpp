@@ -1,0 +1,138 @@
+/** \file RawlogEntryCheck_unittest.cpp
+ * The size check ahead of MRPT's deserialization: intact entries pass and deserialize through
+ * the replayed prefix exactly as they were written; damaged range image and point counts are
+ * named; a truncated entry passes the check and is left for the deserializer to report.
+ */
+#include <keygrid/core/RawlogEntryCheck.h>
+#include <gtest/gtest.h>
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
+
+#include <cstring>
+
+using namespace keygrid::core;
+using mrpt::obs::CObservation3DRangeScan;
+
+namespace
+{
+CObservation3DRangeScan::Ptr observation(std::size_t points)
+{
+	auto o = CObservation3DRangeScan::Create();
+	o->hasRangeImage = true;
+	o->rangeUnits = 1e-3f;
+	o->rangeImage.setSize(30, 40);
+	for (int r = 0; r < 30; r++)
+		for (int c = 0; c < 40; c++) o->rangeImage(r, c) = static_cast<uint16_t>(1000 + 7 * r + c);
+	o->cameraParams.ncols = 40;
+	o->cameraParams.nrows = 30;
+	o->hasPoints3D = points > 0;
+	o->resizePoints3DVectors(points);
+	for (std::size_t k = 0; k < points; k++) o->points3D_x[k] = static_cast<float>(k);
+	return o;
+}
+
+std::vector<std::uint8_t> serialize(const mrpt::serialization::CSerializable& obj)
+{
+	mrpt::io::CMemoryStream m;
+	mrpt::serialization::archiveFrom(m) << obj;
+	const auto* p = static_cast<const std::uint8_t*>(m.getRawBufferData());
+	return {p, p + m.getTotalBytesCount()};
+}
+
+/** Offset of the range image's (rows, cols) = (30, 40) in a serialized entry. */
+std::size_t rowsColsOffset(const std::vector<std::uint8_t>& b)
+{
+	const std::uint32_t rc[2] = {30, 40};
+	for (std::size_t i = 0; i + 8 <= b.size(); i++)
+		if (std::memcmp(b.data() + i, rc, 8) == 0) return i;
+	return b.size();
+}
+
+std::string check(const std::vector<std::uint8_t>& bytes, std::vector<std::uint8_t>* consumed = nullptr)
+{
+	mrpt::io::CMemoryStream in;
+	in.assignMemoryNotOwn(bytes.data(), bytes.size());
+	std::vector<std::uint8_t> head;
+	RawlogEntryLimits l;
+	l.bytesLeft = bytes.size();
+	const auto why = checkRawlogEntry(in, head, l);
+	if (consumed) *consumed = head;
+	return why;
+}
+}  // namespace
+
+TEST(RawlogEntryCheck, IntactEntriesPassAndDeserializeThroughTheReplayedPrefix)
+{
+	for (const std::size_t points : {std::size_t{0}, std::size_t{50}})
+	{
+		const auto obs = observation(points);
+		const auto bytes = serialize(*obs);
+		mrpt::io::CMemoryStream in;
+		in.assignMemoryNotOwn(bytes.data(), bytes.size());
+		std::vector<std::uint8_t> head;
+		RawlogEntryLimits l;
+		l.bytesLeft = bytes.size();
+		EXPECT_EQ(checkRawlogEntry(in, head, l), "");
+		// The walk reached the range image size (it stops right after it).
+		EXPECT_EQ(head.size(), rowsColsOffset(bytes) + 8) << points << " points";
+		PrefixedStream replay(head, in);
+		EXPECT_EQ(replay.getPosition(), 0u);
+		auto back = std::dynamic_pointer_cast<CObservation3DRangeScan>(mrpt::serialization::archiveFrom(replay).ReadObject());
+		ASSERT_TRUE(back);
+		EXPECT_EQ(back->rangeImage, obs->rangeImage);
+		EXPECT_EQ(back->points3D_x, obs->points3D_x);
+		EXPECT_EQ(replay.getPosition(), bytes.size());
+	}
+	// Inside a sensory frame too.
+	mrpt::obs::CSensoryFrame sf;
+	sf.insert(observation(0));
+	EXPECT_EQ(check(serialize(sf)), "");
+}
+
+TEST(RawlogEntryCheck, DamagedSizesAreNamed)
+{
+	const auto bytes = serialize(*observation(0));
+	const std::size_t at = rowsColsOffset(bytes);
+	ASSERT_LT(at, bytes.size());
+
+	auto hugeCols = bytes;
+	hugeCols[at + 7] = 0x7f;  // the high byte of cols
+	EXPECT_EQ(check(hugeCols), "CObservation3DRangeScan range image of 2130706472 x 30 pixels (a side over 32768)");
+
+	// Plausible sides, but more pixels than the bytes that follow.
+	auto longer = bytes;
+	const std::uint32_t cols = 2000;
+	std::memcpy(longer.data() + at + 4, &cols, 4);
+	const auto why = check(longer);
+	EXPECT_NE(why.find("range image of 2000 x 30 pixels needs 120000 bytes, more than the"), std::string::npos) << why;
+
+	// A damaged 3D point count.
+	auto withPoints = serialize(*observation(50));
+	const std::uint32_t fifty = 50;
+	std::size_t n = 0;
+	while (n + 4 <= withPoints.size() && std::memcmp(withPoints.data() + n, &fifty, 4) != 0) n++;
+	ASSERT_LT(n, withPoints.size());
+	withPoints[n + 3] = 0x40;
+	EXPECT_NE(check(withPoints).find("declares 1073741874 3D points"), std::string::npos) << check(withPoints);
+
+	// The same damage inside a sensory frame.
+	mrpt::obs::CSensoryFrame sf;
+	sf.insert(observation(0));
+	auto sfBytes = serialize(sf);
+	sfBytes[rowsColsOffset(sfBytes) + 7] = 0x7f;
+	EXPECT_NE(check(sfBytes).find("a side over 32768"), std::string::npos);
+}
+
+TEST(RawlogEntryCheck, ATruncatedEntryIsLeftToTheDeserializer)
+{
+	const auto bytes = serialize(*observation(0));
+	for (const std::size_t cut : {std::size_t{0}, std::size_t{1}, std::size_t{20}, std::size_t{100}, rowsColsOffset(bytes) + 6})
+	{
+		const std::vector<std::uint8_t> part(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(cut));
+		std::vector<std::uint8_t> consumed;
+		EXPECT_EQ(check(part, &consumed), "") << cut;
+		EXPECT_EQ(consumed, part) << "every byte read is kept for the replay, cut " << cut;
+	}
+}
