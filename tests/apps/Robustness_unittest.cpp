@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 
 #include "SlamRunHelpers.h"
@@ -155,6 +156,57 @@ TEST(Robustness, DamagedRangeImageSizeIsNamedAndTheEarlierFramesKept)
 	EXPECT_EQ(v.exitCode(), 1) << v.output;
 	EXPECT_NE(v.output.find("is corrupt at entry 2"), std::string::npos) << v.output;
 	EXPECT_FALSE(mrpt::system::fileExists(dir + "/v.voc"));
+}
+
+// A full disk, made by a file size limit (RLIMIT_FSIZE, with SIGXFSZ ignored: writes past the
+// limit fail with EFBIG): the run ends with an error naming the file, and every output file it
+// leaves is whole: byte-identical to an unlimited run's (report.json, with its timings, a
+// complete JSON object). No temporary file stays behind.
+TEST(Robustness, AFullDiskNamesTheFileAndLeavesNoPartialOutput)
+{
+	const std::string dir = test::scratchDir("robust_full_disk");
+	const std::string cfg = test::writeFastConfig(dir + "/fast_maps.ini", true);
+	const std::string rawlog = dir + "/seq.rawlog";
+	test::writeRawlog(rawlog, goodObservations(4));
+	const ToolRun ref = test::runTool("keygrid-slam", slamArgs(cfg, rawlog, dir + "/ref"));
+	ASSERT_EQ(ref.exitCode(), 0) << ref.output;
+	std::map<std::string, std::uintmax_t> refSizes;
+	for (const auto& e : std::filesystem::directory_iterator(dir + "/ref")) refSizes[e.path().filename().string()] = e.file_size();
+	ASSERT_GE(refSizes.size(), 10u);
+	std::uintmax_t largest = 0;
+	for (const auto& [name, size] : refSizes) largest = std::max(largest, size);
+
+	// Limits in 512-byte blocks: below the smallest files, and below the largest only.
+	for (const std::uintmax_t blocks : {std::uintmax_t{1}, std::uintmax_t{4}, (largest - 1) / 512})
+	{
+		SCOPED_TRACE("limit " + std::to_string(blocks * 512) + " bytes");
+		const std::string out = dir + "/out" + std::to_string(blocks);
+		const ToolRun r = test::runTool("keygrid-slam", slamArgs(cfg, rawlog, out), "trap '' XFSZ; ulimit -f " + std::to_string(blocks) + ";");
+		EXPECT_EXITED(r);
+		EXPECT_EQ(r.exitCode(), 1) << r.output;
+		EXPECT_NE(r.output.find("keygrid-slam: error: "), std::string::npos) << r.output;
+		EXPECT_NE(r.output.find("cannot write '" + out + "/"), std::string::npos) << r.output;
+		EXPECT_NE(r.output.find("File too large"), std::string::npos) << r.output;
+		std::size_t present = 0;
+		for (const auto& e : std::filesystem::recursive_directory_iterator(out))
+		{
+			const std::string name = e.path().filename().string();
+			EXPECT_EQ(name.find(".tmp"), std::string::npos) << "left behind: " << e.path();
+			if (!e.is_regular_file()) continue;
+			present++;
+			EXPECT_LE(e.file_size(), blocks * 512) << name;
+			if (name == "report.json")
+			{
+				const std::string report = test::readTextFile(e.path().string());
+				EXPECT_EQ(report.substr(report.size() - 2), "}\n") << report;
+			}
+			else
+			{
+				EXPECT_EQ(readBytes(e.path().string()), readBytes(dir + "/ref/" + name)) << name << " differs from the unlimited run's";
+			}
+		}
+		EXPECT_LT(present, refSizes.size());
+	}
 }
 
 TEST(Robustness, ObservationsWithoutDepthImageOrValidCalibrationAreSkippedAndCounted)

@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 // keygrid-tum2rawlog run as a user would: output readable by rawlog-edit, clear errors.
 #include <keygrid/core/RawlogFrameSource.h>
 #include <mrpt/system/filesystem.h>
@@ -23,7 +24,7 @@ TEST(Tum2Rawlog, ConvertsAndRawlogEditReadsIt)
 	std::string out;
 	ASSERT_EQ(runCommand(tool() + " --quiet --input " + s.dir + " --output " + dir + "/o.rawlog", &out), 0) << out;
 	EXPECT_NE(out.find("wrote 6 CObservation3DRangeScan"), std::string::npos) << out;
-	EXPECT_FALSE(mrpt::system::fileExists(dir + "/o.rawlog.tmp"));
+	EXPECT_FALSE(mrpt::system::fileExists(keygrid::core::atomicTmpPath(dir + "/o.rawlog")));
 	if (!mrpt::system::fileExists("/usr/bin/rawlog-edit")) GTEST_SKIP() << "rawlog-edit missing (mrpt-apps)";
 	ASSERT_EQ(runCommand("rawlog-edit --info -i " + dir + "/o.rawlog", &out), 0) << out;
 	EXPECT_NE(out.find("Overall number of objects         : 6"), std::string::npos) << out;

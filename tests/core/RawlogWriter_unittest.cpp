@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 // RawlogWriter (RawlogWriter.h): the temp-file-then-rename contract under write failures.
 #include <keygrid/core/Frame.h>
 #include <keygrid/core/RawlogWriter.h>
@@ -25,8 +26,9 @@ TEST(RawlogWriter, AFullDiskIsReportedAndNothingIsLeftBehind)
 	if (!mrpt::system::fileExists("/dev/full")) GTEST_SKIP() << "/dev/full missing";
 	const std::string dir = keygrid::test::scratchDir("rawlog_full_disk");
 	const std::string path = dir + "/full.rawlog";
-	std::remove((path + ".tmp").c_str());
-	std::filesystem::create_symlink("/dev/full", path + ".tmp");
+	const std::string tmp = keygrid::core::atomicTmpPath(path);
+	std::remove(tmp.c_str());
+	std::filesystem::create_symlink("/dev/full", tmp);
 	Frame f;
 	f.camera.width = 640;
 	f.camera.height = 480;
@@ -45,14 +47,14 @@ TEST(RawlogWriter, AFullDiskIsReportedAndNothingIsLeftBehind)
 		catch (const std::exception& e)
 		{
 			threw = true;
-			EXPECT_NE(std::string(e.what()).find("full.rawlog.tmp"), std::string::npos) << e.what();
+			EXPECT_NE(std::string(e.what()).find("cannot write '" + path + "': No space left on device"), std::string::npos) << e.what();
 		}
 		EXPECT_TRUE(threw);
 		EXPECT_THROW(w.write(makeRgbdObservation(f)), std::runtime_error);  // no retry into zlib
 		EXPECT_THROW(w.close(), std::runtime_error);
 	}  // the destructor closes the stream (ASan: no use after free) and drops the temp file
 	EXPECT_FALSE(mrpt::system::fileExists(path));
-	EXPECT_FALSE(std::filesystem::is_symlink(path + ".tmp"));
+	EXPECT_FALSE(std::filesystem::is_symlink(tmp));
 }
 
 // An output path that is a folder is refused when the writer is made, before any frame is
@@ -71,5 +73,5 @@ TEST(RawlogWriter, AFolderAsOutputIsRefusedBeforeAnyFrame)
 	{
 		EXPECT_NE(std::string(e.what()).find("'" + path + "' is a folder"), std::string::npos) << e.what();
 	}
-	EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+	EXPECT_FALSE(std::filesystem::exists(keygrid::core::atomicTmpPath(path)));
 }

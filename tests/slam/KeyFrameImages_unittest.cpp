@@ -94,6 +94,7 @@ TEST(KeyFrameImageCache, KeepsAtMostItsCapacityEvictingTheLeastRecentlyUsed)
 	EXPECT_EQ(cache.cachedBytes(), 2 * b);
 	EXPECT_LE(cache.cachedBytes(), cache.capacityBytes());
 	EXPECT_EQ(cache.stats().evictions, 1u);  // keyframe 0
+	EXPECT_EQ(cache.spilledBytes(), b) << "only evicted images are written to the spill file";
 
 	cache.get(1);  // hit: 1 becomes the most recent, 2 the least
 	EXPECT_EQ(cache.stats().hits, 1u);
@@ -101,6 +102,7 @@ TEST(KeyFrameImageCache, KeepsAtMostItsCapacityEvictingTheLeastRecentlyUsed)
 	EXPECT_EQ(cache.stats().misses, 1u);
 	EXPECT_TRUE(sameBits(zero.depth, depthImage(0)));
 	EXPECT_EQ(cache.stats().evictions, 2u);
+	EXPECT_EQ(cache.spilledBytes(), 2 * b) << "keyframe 0 is not written twice";
 	cache.get(1);
 	EXPECT_EQ(cache.stats().hits, 2u);  // 1 stayed
 	cache.get(2);

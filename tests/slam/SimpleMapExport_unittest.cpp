@@ -3,6 +3,7 @@
  * cache) is byte for byte what CSimpleMap's own serialization of the whole map in RAM gives,
  * and MRPT reads it back as that map.
  */
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/slam/KeyFrameImageCache.h>
 #include <keygrid/slam/SimpleMapExport.h>
 #include <mrpt/io/CFileGZInputStream.h>
@@ -68,7 +69,7 @@ TEST(SimpleMapExport, StreamedFileIsCSimpleMapsOwnSerialization)
 	const std::string dir = test::scratchDir("simplemap_stream");
 	const auto inRam = keyframesSimpleMap(map);
 	ASSERT_EQ(inRam.size(), 3u);  // the keyframe without images is left out
-	saveGzAtomically(inRam, dir + "/whole.simplemap");
+	core::saveGzAtomically(inRam, dir + "/whole.simplemap");
 
 	// The images leave the keyframes for a cache that keeps none in RAM.
 	KeyFrameImageCache cache(0);
@@ -101,6 +102,6 @@ TEST(SimpleMapExport, EmptyMapStreamsAnEmptySimpleMap)
 {
 	const std::string dir = test::scratchDir("simplemap_stream_empty");
 	EXPECT_EQ(writeKeyframesSimpleMap(sfm::SparseMap(), KeyFrameImagesInRam(), dir + "/a.simplemap"), 0u);
-	saveGzAtomically(mrpt::maps::CSimpleMap(), dir + "/b.simplemap");
+	core::saveGzAtomically(mrpt::maps::CSimpleMap(), dir + "/b.simplemap");
 	EXPECT_TRUE(fileBytes(dir + "/a.simplemap") == fileBytes(dir + "/b.simplemap"));
 }

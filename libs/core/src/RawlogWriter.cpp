@@ -1,5 +1,5 @@
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/core/RawlogWriter.h>
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/serialization/CArchive.h>
@@ -13,37 +13,24 @@ namespace keygrid::core
 {
 struct RawlogWriter::Impl
 {
-	/** The last serialized observation. It must outlive `out`: when a write fails (disk full),
-	 * zlib keeps pointing at the input it could not compress, and gzclose() compresses it
-	 * again. Written from the observation's own image buffers, that read freed memory once the
-	 * caller had dropped the observation (found by AddressSanitizer with a full disk). */
-	mrpt::io::CMemoryStream chunk;
-	mrpt::io::CFileGZOutputStream out;
-	bool failed{false};
+	std::unique_ptr<AtomicGzFile> out;
+	mrpt::io::CMemoryStream chunk;  //!< one serialized observation, written in one piece
 };
 
 RawlogWriter::RawlogWriter(const std::string& path, const RawlogWriterOptions& opts)
-	: m_impl(std::make_unique<Impl>()), m_path(path), m_tmpPath(path + ".tmp"), m_opts(opts)
+	: m_impl(std::make_unique<Impl>()), m_path(path), m_opts(opts)
 {
 	// Before any frame is converted: a folder cannot take the rawlog's name at the end.
 	if (std::filesystem::is_directory(path)) throw std::runtime_error("output '" + path + "' is a folder, not a file");
 	const std::string dir = mrpt::system::extractFileDirectory(path);
 	if (!dir.empty() && !mrpt::system::directoryExists(dir))
 		throw std::runtime_error("output folder '" + dir + "' does not exist");
-	if (!m_impl->out.open(m_tmpPath, opts.compressionLevel))
-		throw std::runtime_error("cannot write '" + m_tmpPath + "'");
+	m_impl->out = std::make_unique<AtomicGzFile>(path, opts.compressionLevel);
 	const std::filesystem::path p(path);
 	m_imagesDir = (p.parent_path() / (p.stem().string() + "_Images")).string();
 }
 
-RawlogWriter::~RawlogWriter()
-{
-	if (m_impl && m_impl->out.is_open())
-	{
-		m_impl->out.close();
-		std::remove(m_tmpPath.c_str());
-	}
-}
+RawlogWriter::~RawlogWriter() = default;  // an uncommitted AtomicGzFile removes its temporary file
 
 void RawlogWriter::write(const mrpt::obs::CObservation::Ptr& obs)
 {
@@ -57,30 +44,22 @@ void RawlogWriter::write(const mrpt::obs::CObservation::Ptr& obs)
 			char name[64];
 			std::snprintf(name, sizeof(name), "rgb_%06zu.png", m_count);
 			const std::string full = m_imagesDir + "/" + name;
-			if (!o->intensityImage.saveToFile(full))
-				throw std::runtime_error("cannot write '" + full + "'");
+			writeFileThrough(full, [&](const std::string& tmp) { return o->intensityImage.saveToFile(tmp); });
 			o->intensityImage.setExternalStorage(name);  // relative to the images dir
 		}
-	// After a failed write zlib refers to `chunk` until close(): it must not change any more.
-	if (m_impl->failed) throw std::runtime_error("cannot write '" + m_tmpPath + "' (an earlier write failed)");
+	if (!m_impl->out) throw std::logic_error("RawlogWriter: write after close");
 	m_impl->chunk.clear();
 	auto arch = mrpt::serialization::archiveFrom(m_impl->chunk);
 	arch << *obs;
-	const auto n = static_cast<size_t>(m_impl->chunk.getTotalBytesCount());
-	if (m_impl->out.Write(m_impl->chunk.getRawBufferData(), n) != n)
-	{
-		m_impl->failed = true;
-		throw std::runtime_error("cannot write '" + m_tmpPath + "' (disk full?)");
-	}
+	m_impl->out->Write(m_impl->chunk.getRawBufferData(), static_cast<size_t>(m_impl->chunk.getTotalBytesCount()));
 	++m_count;
 }
 
 void RawlogWriter::close()
 {
-	if (m_impl->failed) throw std::runtime_error("cannot write '" + m_tmpPath + "' (an earlier write failed)");
-	m_impl->out.close();
-	if (std::rename(m_tmpPath.c_str(), m_path.c_str()) != 0)
-		throw std::runtime_error("cannot rename '" + m_tmpPath + "' to '" + m_path + "'");
+	if (!m_impl->out) throw std::logic_error("RawlogWriter: closed twice");
+	auto out = std::move(m_impl->out);
+	out->commit();
 }
 
 }  // namespace keygrid::core

@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/core/TumTrajectory.h>
 #include <mrpt/math/CQuaternion.h>
 #include <mrpt/poses/CPose3DQuat.h>
@@ -83,12 +84,11 @@ std::string tumLine(const StampedPose& p)
 
 void writeTumTrajectory(const std::string& path, const Trajectory& traj, const std::string& header)
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error("cannot write '" + path + "'");
-	f << "# " << (header.empty() ? "keygrid trajectory" : header) << "\n";
-	f << "# timestamp tx ty tz qx qy qz qw  (T_world_cam, optical frame)\n";
-	for (const auto& p : traj) f << tumLine(p) << "\n";
-	if (!f) throw std::runtime_error("error while writing '" + path + "'");
+	writeFileAtomically(path, [&](std::ostream& f) {
+		f << "# " << (header.empty() ? "keygrid trajectory" : header) << "\n";
+		f << "# timestamp tx ty tz qx qy qz qw  (T_world_cam, optical frame)\n";
+		for (const auto& p : traj) f << tumLine(p) << "\n";
+	});
 }
 
 }  // namespace keygrid::core

@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 /** \file PoseGraphG2o.cpp
  * g2o text export/import of the pose graph (VERTEX_SE3:QUAT / EDGE_SE3:QUAT / FIX). */
 #include <keygrid/loop/PoseGraph.h>
@@ -33,30 +34,28 @@ Eigen::Isometry3d readPose(std::istream& is)
 
 void PoseGraph::writeG2o(const std::string& path) const
 {
-	std::ofstream f(path, std::ios::trunc);
-	if (!f) throw std::runtime_error("cannot write " + path);
-	f << std::setprecision(17);
-	f << "# keygrid pose graph: VERTEX_SE3:QUAT id x y z qx qy qz qw (T_world_kf); EDGE_SE3:QUAT a b T_a_b\n"
-	  << "# + 21 upper-triangular information entries, order x y z rx ry rz (rotation error 2 vec(dq))\n";
-	for (const auto& [id, T] : m_poses)
-	{
-		f << "VERTEX_SE3:QUAT " << id << ' ';
-		writePose(f, T);
-		f << '\n';
-	}
-	for (KeyFrameId id : m_fixed) f << "FIX " << id << '\n';
-	for (const auto& e : m_edges)
-	{
-		if (e.kind == EdgeKind::Loop) f << "# loop\n";
-		else if (e.kind == EdgeKind::Covisibility) f << "# covisibility\n";
-		f << "EDGE_SE3:QUAT " << e.a << ' ' << e.b << ' ';
-		writePose(f, e.T_a_b);
-		for (int r = 0; r < 6; ++r)
-			for (int c = r; c < 6; ++c) f << ' ' << e.information(r, c);
-		f << '\n';
-	}
-	f.close();
-	if (!f) throw std::runtime_error("cannot write " + path);
+	core::writeFileAtomically(path, [&](std::ostream& f) {
+		f << std::setprecision(17);
+		f << "# keygrid pose graph: VERTEX_SE3:QUAT id x y z qx qy qz qw (T_world_kf); EDGE_SE3:QUAT a b T_a_b\n"
+		  << "# + 21 upper-triangular information entries, order x y z rx ry rz (rotation error 2 vec(dq))\n";
+		for (const auto& [id, T] : m_poses)
+		{
+			f << "VERTEX_SE3:QUAT " << id << ' ';
+			writePose(f, T);
+			f << '\n';
+		}
+		for (KeyFrameId id : m_fixed) f << "FIX " << id << '\n';
+		for (const auto& e : m_edges)
+		{
+			if (e.kind == EdgeKind::Loop) f << "# loop\n";
+			else if (e.kind == EdgeKind::Covisibility) f << "# covisibility\n";
+			f << "EDGE_SE3:QUAT " << e.a << ' ' << e.b << ' ';
+			writePose(f, e.T_a_b);
+			for (int r = 0; r < 6; ++r)
+				for (int c = r; c < 6; ++c) f << ' ' << e.information(r, c);
+			f << '\n';
+		}
+	});
 }
 
 PoseGraph PoseGraph::readG2o(const std::string& path)

@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 /** \file VocabularyIO.cpp
  * Binary file format of the vocabulary (all integers little-endian, as written by x86/ARM):
  *
@@ -67,11 +68,7 @@ void Vocabulary::save(std::ostream& os) const
 
 void Vocabulary::save(const std::string& path) const
 {
-	std::ofstream f(path, std::ios::binary | std::ios::trunc);
-	if (!f) throw std::runtime_error("cannot write vocabulary file " + path);
-	save(f);
-	f.close();
-	if (!f) throw std::runtime_error("cannot write vocabulary file " + path);
+	core::writeFileAtomically(path, [&](std::ostream& f) { save(f); });
 }
 
 Vocabulary Vocabulary::load(std::istream& is)

@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 /** \file CHOCPointsMap_io.cpp
  * CHOCPointsMap: versioned serialization (options, points, descriptors, histograms), PLY export
  * and SceneViewer3D visualization.
@@ -109,27 +110,26 @@ void CHOCPointsMap::serializeFrom(mrpt::serialization::CArchive& in, uint8_t ver
 
 void CHOCPointsMap::saveAsPly(const std::string& path, const maps::ExportFrame& frame) const
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error("cannot write '" + path + "'");
-	f << "ply\nformat ascii 1.0\ncomment keygrid CHOCPointsMap: colour and weight = largest HOC bin weight\n";
-	if (!frame.comment.empty()) f << "comment " << frame.comment << "\n";
-	const bool move = !frame.isIdentity();
-	f << "element vertex " << m_points.size() << "\n";
-	f << "property float x\nproperty float y\nproperty float z\n";
-	f << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
-	f << "property float weight\nproperty int observations\nend_header\n";
-	char line[200];
-	for (std::size_t i = 0; i < m_points.size(); i++)
-	{
-		const auto& p = m_points[i];
-		const double w = maxWeight(i);
-		const auto c = weightColour(w);
-		const auto q = move ? frame.T_out_world.composePoint(p.p) : p.p;
-		std::snprintf(line, sizeof(line), "%.5f %.5f %.5f %d %d %d %.4f %d\n", q.x, q.y, q.z, static_cast<int>(255 * c.R),
-					  static_cast<int>(255 * c.G), static_cast<int>(255 * c.B), w, positiveObservations(p.hoc));
-		f << line;
-	}
-	if (!f.good()) throw std::runtime_error("error writing '" + path + "'");
+	core::writeFileAtomically(path, [&](std::ostream& f) {
+		f << "ply\nformat ascii 1.0\ncomment keygrid CHOCPointsMap: colour and weight = largest HOC bin weight\n";
+		if (!frame.comment.empty()) f << "comment " << frame.comment << "\n";
+		const bool move = !frame.isIdentity();
+		f << "element vertex " << m_points.size() << "\n";
+		f << "property float x\nproperty float y\nproperty float z\n";
+		f << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+		f << "property float weight\nproperty int observations\nend_header\n";
+		char line[200];
+		for (std::size_t i = 0; i < m_points.size(); i++)
+		{
+			const auto& p = m_points[i];
+			const double w = maxWeight(i);
+			const auto c = weightColour(w);
+			const auto q = move ? frame.T_out_world.composePoint(p.p) : p.p;
+			std::snprintf(line, sizeof(line), "%.5f %.5f %.5f %d %d %d %.4f %d\n", q.x, q.y, q.z, static_cast<int>(255 * c.R),
+						  static_cast<int>(255 * c.G), static_cast<int>(255 * c.B), w, positiveObservations(p.hoc));
+			f << line;
+		}
+	});
 }
 
 void CHOCPointsMap::saveMetricMapRepresentationToFile(const std::string& prefix) const { saveAsPly(prefix + ".ply"); }

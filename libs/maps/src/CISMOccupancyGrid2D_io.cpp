@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 /** \file CISMOccupancyGrid2D_io.cpp
  * Versioned serialization, exports (ROS map_server pgm + yaml, image, COccupancyGridMap2D)
  * and the 3D visualization.
@@ -169,37 +170,30 @@ void CISMOccupancyGrid2D::saveAsRosMapServer(const std::string& yamlPath) const
 	const std::string pgmName = slash == std::string::npos ? pgmPath : pgmPath.substr(slash + 1);
 
 	// map_server trinary convention: p = (255 - v) / 255 with v = 0 occupied, 254 free, 205 unknown.
-	std::ofstream pgm(pgmPath, std::ios::binary);
-	if (!pgm) throw std::runtime_error("cannot write '" + pgmPath + "'");
-	pgm << "P5\n# keygrid::CISMOccupancyGrid2D\n" << m_sizeX << " " << m_sizeY << "\n255\n";
-	std::vector<unsigned char> row(static_cast<size_t>(m_sizeX));
-	for (int r = 0; r < m_sizeY; r++)
-	{
-		const int cy = m_sizeY - 1 - r;  // image row 0 is the top = largest y
-		for (int cx = 0; cx < m_sizeX; cx++)
+	core::writeFileAtomically(pgmPath, [&](std::ostream& pgm) {
+		pgm << "P5\n# keygrid::CISMOccupancyGrid2D\n" << m_sizeX << " " << m_sizeY << "\n255\n";
+		std::vector<unsigned char> row(static_cast<size_t>(m_sizeX));
+		for (int r = 0; r < m_sizeY; r++)
 		{
-			const CellState s = cellState(cx, cy);
-			row[static_cast<size_t>(cx)] = s == CellState::Occupied ? 0 : s == CellState::Free ? 254 : 205;
+			const int cy = m_sizeY - 1 - r;  // image row 0 is the top = largest y
+			for (int cx = 0; cx < m_sizeX; cx++)
+			{
+				const CellState s = cellState(cx, cy);
+				row[static_cast<size_t>(cx)] = s == CellState::Occupied ? 0 : s == CellState::Free ? 254 : 205;
+			}
+			pgm.write(reinterpret_cast<const char*>(row.data()), static_cast<std::streamsize>(row.size()));
 		}
-		pgm.write(reinterpret_cast<const char*>(row.data()), static_cast<std::streamsize>(row.size()));
-	}
-	pgm.close();
-	if (!pgm) throw std::runtime_error("error writing '" + pgmPath + "'");
+	});
 
-	std::ofstream yaml(yamlPath);
-	if (!yaml) throw std::runtime_error("cannot write '" + yamlPath + "'");
 	char buf[512];
-	// The floor frame in the world (a comment: map_server and MRPT ignore it), so that a map
-	// whose floor was estimated can be compared with a ground truth in another frame. First
-	// line: libfyaml 0.8 (MRPT's YAML reader) leaks its input buffer on a trailing comment.
-	yaml << "# " << maps::floorFrameComment(floorPose()) << "\n";
 	std::snprintf(buf, sizeof(buf),
 		"image: %s\nresolution: %.9g\norigin: [%.9g, %.9g, 0.0]\nnegate: 0\n"
 		"occupied_thresh: 0.65\nfree_thresh: 0.196\n",
 		pgmName.c_str(), m_resolution, m_xMin, m_yMin);
-	yaml << buf;
-	yaml.close();
-	if (!yaml) throw std::runtime_error("error writing '" + yamlPath + "'");
+	// The floor frame in the world (a comment: map_server and MRPT ignore it), so that a map
+	// whose floor was estimated can be compared with a ground truth in another frame. First
+	// line: libfyaml 0.8 (MRPT's YAML reader) leaks its input buffer on a trailing comment.
+	core::writeFileAtomically(yamlPath, "# " + maps::floorFrameComment(floorPose()) + "\n" + buf);
 }
 
 namespace
@@ -220,8 +214,8 @@ mrpt::img::CImage toGreyImage(const CISMOccupancyGrid2D& g)
 
 void CISMOccupancyGrid2D::saveAsImage(const std::string& file) const
 {
-	if (!toGreyImage(*this).saveToFile(file))
-		throw std::runtime_error("cannot write image '" + file + "'");
+	const auto img = toGreyImage(*this);
+	core::writeFileThrough(file, [&](const std::string& tmp) { return img.saveToFile(tmp); });
 }
 
 mrpt::maps::COccupancyGridMap2D CISMOccupancyGrid2D::toOccupancyGridMap2D() const

@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 /** \file CSubmappedOccupancyGrid3D_io.cpp
  * Versioned serialization, OctoMap .bt and PLY exports, 3D visualization.
  */
@@ -315,10 +316,7 @@ void CSubmappedOccupancyGrid3D::saveAsOctomapBinary(const std::string& path, con
 	   << "id " << tree.getTreeType() << "\nsize " << tree.size() << "\nres " << tree.getResolution() << "\ndata\n";
 	tree.writeBinaryData(bt);
 	if (!bt) throw std::runtime_error("saveAsOctomapBinary: cannot serialize the tree");
-	const std::string data = bt.str();
-	std::ofstream f(path, std::ios::binary);
-	f.write(data.data(), static_cast<std::streamsize>(data.size()));
-	if (!f) throw std::runtime_error("saveAsOctomapBinary: cannot write '" + path + "'");
+	core::writeFileAtomically(path, bt.str());
 }
 
 void CSubmappedOccupancyGrid3D::saveOccupiedAsPly(const std::string& path, const maps::ExportFrame& frame) const
@@ -326,15 +324,14 @@ void CSubmappedOccupancyGrid3D::saveOccupiedAsPly(const std::string& path, const
 	auto pts = occupiedVoxelCentres();
 	if (!frame.isIdentity())
 		for (auto& p : pts) p = frame.T_out_world.composePoint(p);
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error("saveOccupiedAsPly: cannot write '" + path + "'");
-	f << "ply\nformat ascii 1.0\ncomment keygrid CSubmappedOccupancyGrid3D occupied voxel "
-		 "centres, resolution "
-	  << m_resolution << " m\n";
-	if (!frame.comment.empty()) f << "comment " << frame.comment << "\n";
-	f << "element vertex " << pts.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-	for (const auto& p : pts) f << float(p.x) << ' ' << float(p.y) << ' ' << float(p.z) << '\n';
-	if (!f) throw std::runtime_error("saveOccupiedAsPly: error writing '" + path + "'");
+	core::writeFileAtomically(path, [&](std::ostream& f) {
+		f << "ply\nformat ascii 1.0\ncomment keygrid CSubmappedOccupancyGrid3D occupied voxel "
+			 "centres, resolution "
+		  << m_resolution << " m\n";
+		if (!frame.comment.empty()) f << "comment " << frame.comment << "\n";
+		f << "element vertex " << pts.size() << "\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+		for (const auto& p : pts) f << float(p.x) << ' ' << float(p.y) << ' ' << float(p.z) << '\n';
+	});
 }
 
 void CSubmappedOccupancyGrid3D::saveMetricMapRepresentationToFile(const std::string& prefix) const
@@ -350,8 +347,7 @@ void CSubmappedOccupancyGrid3D::saveAs3DScene(const std::string& path) const
 	auto objs = mrpt::opengl::CSetOfObjects::Create();
 	getVisualizationInto(*objs);
 	scene.insert(objs);
-	if (!scene.saveToFile(path))
-		throw std::runtime_error("saveAs3DScene: cannot write '" + path + "'");
+	core::saveGzAtomically(scene, path);  // what COpenGLScene::saveToFile writes, with the close checked
 }
 
 void CSubmappedOccupancyGrid3D::getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const

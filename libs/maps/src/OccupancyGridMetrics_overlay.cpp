@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 /** \file OccupancyGridMetrics_overlay.cpp
  * The overlay image of an estimated grid on a ground-truth floor plan (saveOverlayImage). */
 #include <keygrid/maps/OccupancyGridMetrics.h>
@@ -79,7 +80,7 @@ std::array<size_t, kCellVerdictCount> saveOverlayImage(
 				mrpt::img::TColor(0, 0, 0));
 		}
 	}
-	if (!img.saveToFile(path)) throw std::runtime_error("cannot write overlay image '" + path + "'");
+	core::writeFileThrough(path, [&](const std::string& tmp) { return img.saveToFile(tmp); });
 	return counts;
 }
 

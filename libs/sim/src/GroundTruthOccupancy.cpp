@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/core/TumText.h>
 #include <keygrid/sim/GroundTruthOccupancy.h>
 #include <keygrid/sim/Scene.h>
@@ -44,18 +45,17 @@ void VoxelSet::finalize()
 
 void VoxelSet::save(const std::string& path) const
 {
-	std::ofstream f(path);
-	if (!f) throw std::runtime_error("cannot write '" + path + "'");
-	f << "# keygrid ground-truth voxels: world frame (z up), metres.\n"
-		 "# Voxel (i j k) is [origin + i*res, origin + (i+1)*res) per axis.\n"
-		 "KEYGRID_VOXELS 1\n";
-	char buf[128];
-	std::snprintf(
-		buf, sizeof(buf), "resolution %.9g\norigin %.9g %.9g %.9g\ncount %zu\n", m_res,
-		m_origin.x(), m_origin.y(), m_origin.z(), m_voxels.size());
-	f << buf;
-	for (const auto& v : m_voxels) f << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
-	if (!f) throw std::runtime_error("error writing '" + path + "'");
+	core::writeFileAtomically(path, [&](std::ostream& f) {
+		f << "# keygrid ground-truth voxels: world frame (z up), metres.\n"
+			 "# Voxel (i j k) is [origin + i*res, origin + (i+1)*res) per axis.\n"
+			 "KEYGRID_VOXELS 1\n";
+		char buf[128];
+		std::snprintf(
+			buf, sizeof(buf), "resolution %.9g\norigin %.9g %.9g %.9g\ncount %zu\n", m_res,
+			m_origin.x(), m_origin.y(), m_origin.z(), m_voxels.size());
+		f << buf;
+		for (const auto& v : m_voxels) f << v[0] << ' ' << v[1] << ' ' << v[2] << '\n';
+	});
 }
 
 VoxelSet VoxelSet::load(const std::string& path)
@@ -126,17 +126,14 @@ void FloorPlan::save(const std::string& stem) const
 	for (int cy = 0; cy < height; cy++)
 		for (int cx = 0; cx < width; cx++)
 			img.at<std::uint8_t>(height - 1 - cy, cx) = occupied[cy * width + cx] ? 0 : 254;
-	if (!cv::imwrite(stem + ".pgm", img))
-		throw std::runtime_error("cannot write '" + stem + ".pgm'");
-	std::ofstream f(stem + ".yaml");
+	core::writeFileThrough(stem + ".pgm", [&](const std::string& tmp) { return cv::imwrite(tmp, img); });
 	char buf[256];
 	std::snprintf(
 		buf, sizeof(buf),
 		"image: %s.pgm\nresolution: %.9g\norigin: [%.9g, %.9g, 0.0]\nnegate: 0\n"
 		"occupied_thresh: 0.65\nfree_thresh: 0.196\n",
 		mrpt::system::extractFileName(stem).c_str(), resolution, origin.x(), origin.y());
-	f << buf;
-	if (!f) throw std::runtime_error("cannot write '" + stem + ".yaml'");
+	core::writeFileAtomically(stem + ".yaml", buf);
 }
 
 FloorPlan FloorPlan::load(const std::string& yamlPath)

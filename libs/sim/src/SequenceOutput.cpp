@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 #include "SequenceOutput.h"
 
 #include <keygrid/core/RawlogWriter.h>
@@ -34,20 +35,16 @@ std::string stamp(double t)
 
 void writePng(const std::string& path, const cv::Mat& img, int compression)
 {
-	bool ok = false;
-	try
-	{
-		ok = cv::imwrite(path, img, {cv::IMWRITE_PNG_COMPRESSION, compression});
-	}
-	catch (const cv::Exception&)
-	{
-		ok = false;
-	}
-	if (!ok)
-	{
-		std::remove(path.c_str());  // no truncated image under the final name
-		throw std::runtime_error("cannot write '" + path + "'");
-	}
+	core::writeFileThrough(path, [&](const std::string& tmp) {
+		try
+		{
+			return cv::imwrite(tmp, img, {cv::IMWRITE_PNG_COMPRESSION, compression});
+		}
+		catch (const cv::Exception& e)
+		{
+			throw std::runtime_error(e.err);
+		}
+	});
 }
 }  // namespace
 
@@ -78,10 +75,7 @@ class TumFolderWriter
 		core::RgbdCamera c = camera;
 		c.depthUnits = 0.0002f;
 		c.saveToConfigFile(cam, "camera");
-		std::ofstream ini(dir + "/camera.ini");
-		ini << cam.getContent();
-		ini.close();
-		if (ini.fail()) throw std::runtime_error("cannot write '" + dir + "/camera.ini'");
+		core::writeFileAtomically(dir + "/camera.ini", cam.getContent());
 	}
 	~TumFolderWriter()
 	{

@@ -13,11 +13,12 @@ KeyFrameImageCache::KeyFrameImageCache(std::size_t capacityBytes, const std::str
 
 void KeyFrameImageCache::put(sfm::KeyFrameId id, const KeyFrameImageData& images)
 {
-	// Written outside the lock (the file has its own): readers of other keyframes go on.
-	Stored s{m_file.append(images.depth), m_file.append(images.colour)};
 	std::lock_guard<std::mutex> lk(m_mutex);
-	m_stored[id] = s;
 	forget(id);
+	Stored s;
+	s.hasDepth = !images.depth.empty();
+	s.hasColour = !images.colour.empty();
+	m_stored[id] = s;
 	remember(id, images);
 }
 
@@ -50,7 +51,7 @@ bool KeyFrameImageCache::hasImages(const sfm::KeyFrame& kf) const
 	if (!kf.depth.empty() || !kf.colour.empty()) return !kf.depth.empty() && !kf.colour.empty();
 	std::lock_guard<std::mutex> lk(m_mutex);
 	const auto it = m_stored.find(kf.id);
-	return it != m_stored.end() && !it->second.depth.empty() && !it->second.colour.empty();
+	return it != m_stored.end() && it->second.hasDepth && it->second.hasColour;
 }
 
 KeyFrameImageData KeyFrameImageCache::load(const sfm::KeyFrame& kf) const
@@ -62,15 +63,30 @@ KeyFrameImageData KeyFrameImageCache::load(const sfm::KeyFrame& kf) const
 void KeyFrameImageCache::remember(sfm::KeyFrameId id, const KeyFrameImageData& images) const
 {
 	const std::size_t bytes = bytesOf(images.depth) + bytesOf(images.colour);
-	if (bytes > m_capacity) return;  // would not fit even alone
+	if (bytes > m_capacity)  // would not fit even alone
+	{
+		spill(id, images);
+		return;
+	}
 	m_lru.push_front(id);
 	m_cached[id] = Cached{images, bytes, m_lru.begin()};
 	m_cachedBytes += bytes;
 	while (m_cachedBytes > m_capacity)
 	{
-		forget(m_lru.back());
+		const sfm::KeyFrameId oldest = m_lru.back();
+		spill(oldest, m_cached.at(oldest).images);
+		forget(oldest);
 		m_stats.evictions++;
 	}
+}
+
+void KeyFrameImageCache::spill(sfm::KeyFrameId id, const KeyFrameImageData& images) const
+{
+	Stored& s = m_stored.at(id);
+	if (s.inFile) return;
+	s.depth = m_file.append(images.depth);
+	s.colour = m_file.append(images.colour);
+	s.inFile = true;
 }
 
 void KeyFrameImageCache::forget(sfm::KeyFrameId id) const

@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/core/ConfigReading.h>
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
@@ -398,20 +399,20 @@ std::vector<std::string> MetricMaps::writeOutputsInto(const std::string& dir) co
 		{
 			ism->saveAsRosMapServer(dir + "/map_2d" + suffix + ".yaml");
 			ism->saveAsImage(dir + "/map_2d" + suffix + ".png");
-			saveGzAtomically(*ism, dir + "/map_2d" + suffix + ".bin");
+			core::saveGzAtomically(*ism, dir + "/map_2d" + suffix + ".bin");
 			files.insert(files.end(), {"map_2d" + suffix + ".yaml", "map_2d" + suffix + ".pgm", "map_2d" + suffix + ".png", "map_2d" + suffix + ".bin"});
 		}
 		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
 		{
 			g3->saveAsOctomapBinary(dir + "/map_3d" + suffix + ".bt", frame);
 			g3->saveOccupiedAsPly(dir + "/map_3d" + suffix + ".ply", frame);
-			saveGzAtomically(*g3, dir + "/map_3d" + suffix + ".bin");
+			core::saveGzAtomically(*g3, dir + "/map_3d" + suffix + ".bin");
 			files.insert(files.end(), {"map_3d" + suffix + ".bt", "map_3d" + suffix + ".ply", "map_3d" + suffix + ".bin"});
 		}
 		else if (const auto* hoc = dynamic_cast<const CHOCPointsMap*>(m.get()))
 		{
 			hoc->saveAsPly(dir + "/hoc_points" + suffix + ".ply", frame);
-			saveGzAtomically(*hoc, dir + "/hoc_points" + suffix + ".bin");
+			core::saveGzAtomically(*hoc, dir + "/hoc_points" + suffix + ".bin");
 			files.insert(files.end(), {"hoc_points" + suffix + ".ply", "hoc_points" + suffix + ".bin"});
 		}
 		else

@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/slam/SceneExport.h>
 #include <keygrid/slam/SimpleMapExport.h>
@@ -147,7 +148,7 @@ void writeRunScene(
 	const core::Trajectory& trajectory, const sfm::SparseMap& map, const mrpt::maps::CMultiMetricMap* maps,
 	const std::optional<mrpt::poses::CPose3D>& T_world_floor, const std::string& path, const SceneExportOptions& opts)
 {
-	saveGzAtomically(*buildRunScene(trajectory, map, maps, T_world_floor, opts), path);
+	core::saveGzAtomically(*buildRunScene(trajectory, map, maps, T_world_floor, opts), path);
 }
 
 }  // namespace keygrid::slam

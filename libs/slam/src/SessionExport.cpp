@@ -1,7 +1,7 @@
 #include <keygrid/core/Frame.h>
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/maps/ExportFrame.h>
-#include <keygrid/slam/AtomicFile.h>
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SessionExport.h>
 #include <keygrid/slam/SessionLoader.h>
@@ -33,7 +33,7 @@ SessionExportResult exportSession(const std::string& file, const std::string& di
 		std::ostringstream t;
 		t << "# keyframes of session " << file << "\n# timestamp tx ty tz qx qy qz qw  (T_world_cam, optical frame)\n";
 		for (const auto& [id, kf] : map.keyframes()) t << core::tumLine({kf.timestamp, kf.T_world_cam}) << "\n";
-		writeFileAtomically(dir + "/keyframes.txt", t.str());
+		core::writeFileAtomically(dir + "/keyframes.txt", t.str());
 		out.files.push_back("keyframes.txt");
 	}
 

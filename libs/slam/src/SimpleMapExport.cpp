@@ -1,7 +1,7 @@
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/core/RgbdObservation.h>
 #include <keygrid/slam/SimpleMapExport.h>
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
@@ -51,34 +51,6 @@ mrpt::maps::CSimpleMap keyframesSimpleMap(const sfm::SparseMap& map, const KeyFr
 	return sm;
 }
 
-void writeGzAtomically(const std::string& path, const std::function<void(mrpt::serialization::CArchive&)>& write)
-{
-	const std::string tmp = path + ".tmp";
-	try
-	{
-		mrpt::io::CFileGZOutputStream f;
-		if (!f.open(tmp)) throw std::runtime_error("cannot write '" + path + "'");
-		auto a = mrpt::serialization::archiveFrom(f);
-		write(a);
-		f.close();
-	}
-	catch (const std::exception& e)
-	{
-		std::remove(tmp.c_str());
-		throw std::runtime_error("error while writing '" + path + "': " + e.what());
-	}
-	if (std::rename(tmp.c_str(), path.c_str()) != 0)
-	{
-		std::remove(tmp.c_str());
-		throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "'");
-	}
-}
-
-void saveGzAtomically(const mrpt::serialization::CSerializable& obj, const std::string& path)
-{
-	writeGzAtomically(path, [&](mrpt::serialization::CArchive& a) { a << obj; });
-}
-
 namespace
 {
 /** The bytes CArchive writes around a CSimpleMap's content, taken from an empty map's
@@ -111,7 +83,8 @@ std::size_t writeKeyframesSimpleMap(const sfm::SparseMap& map, const KeyFrameIma
 	for (const auto& [id, kf] : map.keyframes())
 		if (images.hasImages(kf)) entries.push_back(&kf);
 	const auto framing = simpleMapFraming();
-	writeGzAtomically(path, [&](mrpt::serialization::CArchive& a) {
+	core::writeGzAtomically(path, [&](mrpt::io::CStream& out) {
+		auto a = mrpt::serialization::archiveFrom(out);
 		a.WriteBuffer(framing.head.data(), framing.head.size());
 		a.WriteAs<uint32_t>(entries.size());
 		for (const sfm::KeyFrame* kf : entries)

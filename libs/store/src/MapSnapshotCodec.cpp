@@ -1,3 +1,4 @@
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/store/GzipBlock.h>
 #include <keygrid/store/MapSnapshotCodec.h>
 #include <mrpt/io/CMemoryStream.h>
@@ -56,9 +57,8 @@ mrpt::serialization::CSerializable::Ptr MapSnapshotCodec::decode(const MapSnapsh
 
 void MapSnapshotCodec::saveAsFile(const MapSnapshot& snapshot, const std::string& path)
 {
-	std::ofstream f(path, std::ios::binary | std::ios::trunc);
-	f.write(reinterpret_cast<const char*>(snapshot.data.data()), static_cast<std::streamsize>(snapshot.data.size()));
-	if (!f) throw std::runtime_error("cannot write map snapshot '" + snapshot.name + "' to '" + path + "'");
+	core::writeFileAtomically(
+		path, std::string(reinterpret_cast<const char*>(snapshot.data.data()), snapshot.data.size()));
 }
 
 }  // namespace keygrid::store

@@ -4,7 +4,7 @@
  * writes the results tables (see BatchApp.h).
  */
 #include <keygrid/core/CommandLine.h>
-#include <keygrid/slam/AtomicFile.h>
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <keygrid/slam/apps/AppRunner.h>
@@ -162,7 +162,7 @@ std::vector<RunMetrics> runBatch(const ExperimentSpec& spec, const BatchRunOptio
 		if (!opts.dryRun)
 		{
 			fs::create_directories(out / "_configs");
-			writeFileAtomically(configPaths.back(), text);
+			core::writeFileAtomically(configPaths.back(), text);
 		}
 	}
 
@@ -216,7 +216,7 @@ std::vector<RunMetrics> runBatch(const ExperimentSpec& spec, const BatchRunOptio
 		runProcesses(genJobs, jobs, spec.batch.timeoutSeconds, [&](std::size_t j, const ProcessOutcome& o) {
 			const std::size_t i = genOf[j];
 			if (o.succeeded())
-				writeFileAtomically((out / "_datasets" / spec.datasets[i].name / "generated-by.txt").string(), genStamps[j]);
+				core::writeFileAtomically((out / "_datasets" / spec.datasets[i].name / "generated-by.txt").string(), genStamps[j]);
 			else
 			{
 				const std::string why = o.launchError.empty() && !o.timedOut ? reasonFromLog(genJobs[j].logPath) : "";
@@ -326,9 +326,9 @@ std::vector<RunMetrics> runBatch(const ExperimentSpec& spec, const BatchRunOptio
 		md << "\n";
 	}
 	md << "\n" << resultsMarkdown(rows);
-	writeFileAtomically((out / "results.md").string(), md.str());
-	writeFileAtomically((out / "results.csv").string(), resultsCsv(rows));
-	writeFileAtomically((out / "runs.csv").string(), runsCsv(runs));
+	core::writeFileAtomically((out / "results.md").string(), md.str());
+	core::writeFileAtomically((out / "results.csv").string(), resultsCsv(rows));
+	core::writeFileAtomically((out / "runs.csv").string(), runsCsv(runs));
 	return runs;
 }
 

@@ -3,7 +3,7 @@
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/EvalApp.h>
 #include <keygrid/slam/apps/MapEvaluation.h>
-#include <keygrid/slam/AtomicFile.h>
+#include <keygrid/core/AtomicOutput.h>
 #include <mrpt/math/CMatrixFixed.h>
 
 #include <iostream>
@@ -105,7 +105,7 @@ int EvalApp::run(int argc, const char* const* argv)
 			if (!mo.overlayPath.empty()) std::cout << "overlay: " << mo.overlayPath << "\n";
 			json = mergeJson(json, m.jsonFields());
 		}
-		if (cl.has("json")) writeFileAtomically(cl.get("json"), json);
+		if (cl.has("json")) core::writeFileAtomically(cl.get("json"), json);
 		return 0;
 	});
 }

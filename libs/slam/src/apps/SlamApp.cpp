@@ -5,7 +5,7 @@
 #include <keygrid/core/PrefetchingFrameSource.h>
 #include <keygrid/core/ProgressBar.h>
 #include <keygrid/eval/TrajectoryErrors.h>
-#include <keygrid/slam/AtomicFile.h>
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/slam/Interrupt.h>
 #include <keygrid/slam/LivePreview.h>
 #include <keygrid/slam/LiveRun.h>
@@ -315,7 +315,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			std::cerr << "keygrid-slam: warning: the new map never met the stored one; its " << ex.waitingForMerge
 					  << " keyframes are in a frame of their own, not in the metric maps nor in " << o.loadMap << "\n";
 	}
-	writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, trajectoryTitle));
+	core::writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, trajectoryTitle));
 	// The run's floor frame (any map configured): every map output is written in it.
 	const std::optional<mrpt::poses::CPose3D> T_world_floor =
 		sys.metricMaps() ? sys.metricMaps()->T_world_floor() : std::nullopt;
@@ -325,13 +325,13 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		t << "# keygrid-slam trajectory in the floor frame (z up, z = 0 on the floor), every frame\n# "
 		  << maps::floorFrameComment(*T_world_floor) << "\n# timestamp tx ty tz qx qy qz qw  (T_floor_cam, optical frame)\n";
 		for (const auto& p : traj) t << core::tumLine({p.t, p.T_world_cam - *T_world_floor}) << "\n";
-		writeFileAtomically(o.output + "/trajectory_floor.txt", t.str());
+		core::writeFileAtomically(o.output + "/trajectory_floor.txt", t.str());
 	}
 	{
 		// As tracked, before later map refinement (diagnostics: trajectory.txt is the final one).
 		core::Trajectory raw;
 		for (const auto& f : sys.frames()) raw.push_back({f.timestamp, f.T_world_cam});
-		writeFileAtomically(o.output + "/trajectory_online.txt", trajectoryText(raw, "keygrid-slam online poses (as tracked)"));
+		core::writeFileAtomically(o.output + "/trajectory_online.txt", trajectoryText(raw, "keygrid-slam online poses (as tracked)"));
 	}
 	{
 		std::ostringstream csv;
@@ -347,9 +347,9 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 						  !sys.localizeOnly() ? "" : f.tracked ? ",localized" : ",lost");
 			csv << line;
 		}
-		writeFileAtomically(o.output + "/frames.csv", csv.str());
+		core::writeFileAtomically(o.output + "/frames.csv", csv.str());
 	}
-	writeFileAtomically(o.output + "/keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
+	core::writeFileAtomically(o.output + "/keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
 	try
 	{
 		// A loaded map's keyframes have their images in the session file, not here.
@@ -385,7 +385,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		}
 		try
 		{
-			writeFileAtomically(o.output + "/loop_queries.csv", csv.str());
+			core::writeFileAtomically(o.output + "/loop_queries.csv", csv.str());
 		}
 		catch (const std::exception& e)
 		{
@@ -587,7 +587,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	}
 	js << "  \"error\": " << (res.error.empty() ? "null" : "\"" + jsonEscape(res.error) + "\"") << "\n";
 	js << "}\n";
-	writeFileAtomically(o.output + "/report.json", js.str());
+	core::writeFileAtomically(o.output + "/report.json", js.str());
 	return res;
 }
 

@@ -2,7 +2,7 @@
 #include <keygrid/core/FrameSource.h>
 #include <keygrid/core/ProgressBar.h>
 #include <keygrid/loop/Vocabulary.h>
-#include <keygrid/slam/AtomicFile.h>
+#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/VocabApp.h>
 #include <opencv2/features2d.hpp>
@@ -158,7 +158,7 @@ int train(const core::CommandLine& cl)
 			" training images, so every word weighs 0: train on more, and more varied, images");
 	std::ostringstream os;
 	v.save(os);
-	writeFileAtomically(cl.get("output"), os.str());
+	core::writeFileAtomically(cl.get("output"), os.str());
 	std::cout << v.describe() << "\n"
 			  << "trained on " << total << " descriptors in " << std::fixed << std::setprecision(1) << bar.elapsed()
 			  << " s -> " << cl.get("output") << " (" << os.str().size() / 1024 << " KiB)\n";

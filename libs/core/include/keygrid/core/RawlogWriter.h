@@ -1,9 +1,10 @@
 #pragma once
 /** \file RawlogWriter.h
- * Writes observations to an MRPT rawlog (observation-only format), atomically: the data go to
- * `<path>.tmp` and are renamed to `<path>` by close(), so a crash never leaves a half file
- * under the final name. A failed write (disk full) throws std::runtime_error naming the temp
- * file; after it write() and close() throw too, and the destructor removes the temp file.
+ * Writes observations to an MRPT rawlog (observation-only format), atomically through an
+ * AtomicGzFile: the data go to a temporary file renamed to `<path>` by close(), so a crash
+ * never leaves a half file under the final name. A failed write (disk full) throws
+ * std::runtime_error naming `<path>`; after it write() and close() throw too, and the
+ * destructor removes the temporary file.
  */
 #include <mrpt/obs/CObservation.h>
 
@@ -40,7 +41,7 @@ class RawlogWriter
    private:
 	struct Impl;
 	std::unique_ptr<Impl> m_impl;
-	std::string m_path, m_tmpPath, m_imagesDir;
+	std::string m_path, m_imagesDir;
 	RawlogWriterOptions m_opts;
 	std::size_t m_count{0};
 };

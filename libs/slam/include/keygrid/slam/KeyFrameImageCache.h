@@ -5,8 +5,10 @@
  * here (put) and the keyframe drops them; whoever needs them later (dense 2D input waiting for
  * the floor, keyframes.simplemap) loads them through the cache.
  *
- * Every image goes to an ImageSpillFile (raw bytes: bit-identical on the way back); an LRU of
- * at most `capacityBytes` keeps the most recently put or read ones in RAM as well.
+ * An LRU of at most `capacityBytes` keeps the most recently put or read images in RAM; images
+ * leave RAM for an ImageSpillFile (raw bytes: bit-identical on the way back) when they are
+ * evicted, or at once when they are larger than the whole cache. A run whose keyframe images
+ * fit in the cache never writes the file.
  */
 #include <keygrid/slam/ImageSpillFile.h>
 #include <keygrid/slam/KeyFrameImageSource.h>
@@ -32,7 +34,8 @@ class KeyFrameImageCache : public KeyFrameImageSource
 	 * file (empty: $TMPDIR, else /tmp). */
 	explicit KeyFrameImageCache(std::size_t capacityBytes, const std::string& spillDir = {});
 
-	/** Stores the images of keyframe `id` (replacing any stored before). Thread-safe. */
+	/** Stores the images of keyframe `id` (replacing any stored before). Thread-safe. Throws
+	 * std::runtime_error when images leaving RAM cannot be written to the spill file. */
 	void put(sfm::KeyFrameId id, const KeyFrameImageData& images);
 	/** Whether images of `id` were put. */
 	bool contains(sfm::KeyFrameId id) const;
@@ -56,6 +59,8 @@ class KeyFrameImageCache : public KeyFrameImageSource
    private:
 	struct Stored
 	{
+		bool inFile{false};  //!< written to the spill file (else only in m_cached)
+		bool hasDepth{false}, hasColour{false};
 		ImageSpillFile::Record depth, colour;
 	};
 	struct Cached
@@ -64,13 +69,16 @@ class KeyFrameImageCache : public KeyFrameImageSource
 		std::size_t bytes{0};
 		std::list<sfm::KeyFrameId>::iterator lru;
 	};
-	/** Puts `images` first in the LRU and evicts from its end down to the capacity. Lock held. */
+	/** Puts `images` first in the LRU and evicts from its end down to the capacity, writing
+	 * evicted images that are not in the spill file yet. Lock held. */
 	void remember(sfm::KeyFrameId id, const KeyFrameImageData& images) const;
 	void forget(sfm::KeyFrameId id) const;
+	/** Writes the images of `id` to the spill file unless they are there already. Lock held. */
+	void spill(sfm::KeyFrameId id, const KeyFrameImageData& images) const;
 
 	std::size_t m_capacity;
-	ImageSpillFile m_file;
-	std::unordered_map<sfm::KeyFrameId, Stored> m_stored;
+	mutable ImageSpillFile m_file;  // written on eviction, also from const get()
+	mutable std::unordered_map<sfm::KeyFrameId, Stored> m_stored;
 	mutable std::list<sfm::KeyFrameId> m_lru;  // most recent first
 	mutable std::unordered_map<sfm::KeyFrameId, Cached> m_cached;
 	mutable std::size_t m_cachedBytes{0};

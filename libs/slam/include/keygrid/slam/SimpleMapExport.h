@@ -33,15 +33,7 @@ mrpt::maps::CSimpleMap::Pair keyframeSimpleMapEntry(const sfm::KeyFrame& kf, con
  * `images`. */
 mrpt::maps::CSimpleMap keyframesSimpleMap(const sfm::SparseMap& map, const KeyFrameImageSource& images = KeyFrameImagesInRam());
 
-/** Writes gz-compressed (as MRPT's tools expect for .simplemap, .3Dscene, ...) to `path`
- * atomically: `write` fills `<path>.tmp`, which is then renamed. Throws std::runtime_error
- * naming the path on failure (the .tmp is removed). */
-void writeGzAtomically(const std::string& path, const std::function<void(mrpt::serialization::CArchive&)>& write);
-
-/** Serializes `obj` with writeGzAtomically. */
-void saveGzAtomically(const mrpt::serialization::CSerializable& obj, const std::string& path);
-
-/** Writes keyframesSimpleMap(map, images) to `path` (as saveGzAtomically would, byte for byte)
+/** Writes keyframesSimpleMap(map, images) to `path` (as core::saveGzAtomically would, byte for byte)
  * with the images of one keyframe at a time in RAM. Returns the number of entries. */
 std::size_t writeKeyframesSimpleMap(const sfm::SparseMap& map, const KeyFrameImageSource& images, const std::string& path);
 
