@@ -136,3 +136,21 @@ TEST(RawlogEntryCheck, ATruncatedEntryIsLeftToTheDeserializer)
 		EXPECT_EQ(consumed, part) << "every byte read is kept for the replay, cut " << cut;
 	}
 }
+
+TEST(RawlogEntryCheck, ADamagedCountClaimsNoMoreMemoryThanTheDataThere)
+{
+	// A gzip rawlog has no known size (bytesLeft unbounded): a point count of 2^30 must not
+	// make the check allocate 16 GiB; it reads what is there and stops.
+	auto bytes = serialize(*observation(50));
+	const std::uint32_t fifty = 50;
+	std::size_t n = 0;
+	while (n + 4 <= bytes.size() && std::memcmp(bytes.data() + n, &fifty, 4) != 0) n++;
+	ASSERT_LT(n, bytes.size());
+	bytes[n + 3] = 0x40;
+	mrpt::io::CMemoryStream in;
+	in.assignMemoryNotOwn(bytes.data(), bytes.size());
+	std::vector<std::uint8_t> head;
+	EXPECT_EQ(checkRawlogEntry(in, head, RawlogEntryLimits{}), "");
+	EXPECT_EQ(head.size(), bytes.size());
+	EXPECT_LE(head.capacity(), 2 * bytes.size() + (std::size_t{1} << 21));
+}

@@ -1,5 +1,6 @@
 #include <keygrid/core/RawlogEntryCheck.h>
 
+#include <algorithm>
 #include <cstring>
 #include <optional>
 #include <stdexcept>
@@ -14,13 +15,21 @@ class Reader
    public:
 	Reader(mrpt::io::CStream& in, std::vector<std::uint8_t>& consumed) : m_in(in), m_consumed(consumed) {}
 
+	/** Reads `n` bytes in pieces of at most 1 MiB, so that a damaged count claims no more
+	 * memory than the data that is really there. */
 	bool bytes(std::size_t n)
 	{
-		const std::size_t at = m_consumed.size();
-		m_consumed.resize(at + n);
-		const std::size_t got = n ? m_in.Read(m_consumed.data() + at, n) : 0;
-		m_consumed.resize(at + got);
-		return got == n;
+		constexpr std::size_t kPiece = std::size_t{1} << 20;
+		for (std::size_t left = n; left > 0;)
+		{
+			const std::size_t want = std::min(left, kPiece), at = m_consumed.size();
+			m_consumed.resize(at + want);
+			const std::size_t got = m_in.Read(m_consumed.data() + at, want);
+			m_consumed.resize(at + got);
+			if (got != want) return false;
+			left -= got;
+		}
+		return true;
 	}
 	template <typename T>
 	std::optional<T> value()

@@ -12,6 +12,8 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
+#include <map>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -362,69 +364,71 @@ MetricMaps MetricMaps::FromMaps(
 
 std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const
 {
-	// Atomic outputs: everything is written into a scratch folder beside the final files, then
-	// each file is renamed into place (also what was written before an error).
 	namespace fs = std::filesystem;
-	const fs::path tmp = fs::path(dir) / ".maps.tmp";
-	fs::remove_all(tmp);
-	fs::create_directories(tmp);
-	auto publish = [&] {
-		for (const auto& e : fs::directory_iterator(tmp)) fs::rename(e.path(), fs::path(dir) / e.path().filename());
-		fs::remove_all(tmp);
-	};
-	try
-	{
-		auto files = writeOutputsInto(tmp.string());
-		publish();
-		return files;
-	}
-	catch (...)
-	{
-		publish();
-		throw;
-	}
-}
-
-std::vector<std::string> MetricMaps::writeOutputsInto(const std::string& dir) const
-{
 	const maps::ExportFrame frame = outputFrame();
 	std::vector<std::string> files;
 	std::map<std::string, int> seen;
+	// Every file is tried: one that fails (full disk) does not keep the others from being
+	// written. The first failure is thrown at the end.
+	std::string firstError;
+	std::size_t failures = 0;
+	auto attempt = [&](const std::string& file, const std::function<void(const std::string&)>& write) {
+		try
+		{
+			write(dir + "/" + file);
+			files.push_back(file);
+			return true;
+		}
+		catch (const std::exception& e)
+		{
+			if (firstError.empty()) firstError = e.what();
+			failures++;
+			return false;
+		}
+	};
 	for (const auto& m : m_maps.maps)
 	{
 		const std::string cls = m->GetRuntimeClass()->className;
 		const int n = seen[cls]++;
 		const std::string suffix = n ? "_" + std::to_string(n) : "";
+		// keygrid's maps write each file atomically (core/AtomicOutput.h).
 		if (const auto* ism = dynamic_cast<const CISMOccupancyGrid2D*>(m.get()))
 		{
-			ism->saveAsRosMapServer(dir + "/map_2d" + suffix + ".yaml");
-			ism->saveAsImage(dir + "/map_2d" + suffix + ".png");
-			core::saveGzAtomically(*ism, dir + "/map_2d" + suffix + ".bin");
-			files.insert(files.end(), {"map_2d" + suffix + ".yaml", "map_2d" + suffix + ".pgm", "map_2d" + suffix + ".png", "map_2d" + suffix + ".bin"});
+			if (attempt("map_2d" + suffix + ".yaml", [&](const std::string& p) { ism->saveAsRosMapServer(p); }))
+				files.push_back("map_2d" + suffix + ".pgm");  // written first, beside the .yaml
+			attempt("map_2d" + suffix + ".png", [&](const std::string& p) { ism->saveAsImage(p); });
+			attempt("map_2d" + suffix + ".bin", [&](const std::string& p) { core::saveGzAtomically(*ism, p); });
 		}
 		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
 		{
-			g3->saveAsOctomapBinary(dir + "/map_3d" + suffix + ".bt", frame);
-			g3->saveOccupiedAsPly(dir + "/map_3d" + suffix + ".ply", frame);
-			core::saveGzAtomically(*g3, dir + "/map_3d" + suffix + ".bin");
-			files.insert(files.end(), {"map_3d" + suffix + ".bt", "map_3d" + suffix + ".ply", "map_3d" + suffix + ".bin"});
+			attempt("map_3d" + suffix + ".bt", [&](const std::string& p) { g3->saveAsOctomapBinary(p, frame); });
+			attempt("map_3d" + suffix + ".ply", [&](const std::string& p) { g3->saveOccupiedAsPly(p, frame); });
+			attempt("map_3d" + suffix + ".bin", [&](const std::string& p) { core::saveGzAtomically(*g3, p); });
 		}
 		else if (const auto* hoc = dynamic_cast<const CHOCPointsMap*>(m.get()))
 		{
-			hoc->saveAsPly(dir + "/hoc_points" + suffix + ".ply", frame);
-			core::saveGzAtomically(*hoc, dir + "/hoc_points" + suffix + ".bin");
-			files.insert(files.end(), {"hoc_points" + suffix + ".ply", "hoc_points" + suffix + ".bin"});
+			attempt("hoc_points" + suffix + ".ply", [&](const std::string& p) { hoc->saveAsPly(p, frame); });
+			attempt("hoc_points" + suffix + ".bin", [&](const std::string& p) { core::saveGzAtomically(*hoc, p); });
 		}
 		else
 		{
-			// MRPT's own representation (e.g. octoMap writes .bt, pointsMap .txt).
+			// MRPT's own representation (e.g. octoMap writes .bt, pointsMap .txt), by writers that
+			// take a file prefix: written into a scratch folder, then renamed into place.
 			std::string base = cls;
 			for (auto& ch : base)
 				if (ch == ':') ch = '_';
-			m->saveMetricMapRepresentationToFile(dir + "/" + base + suffix);
-			files.push_back(base + suffix + ".*");
+			attempt(base + suffix + ".*", [&](const std::string&) {
+				const fs::path tmp = fs::path(dir) / ".maps.tmp";
+				fs::remove_all(tmp);
+				fs::create_directories(tmp);
+				m->saveMetricMapRepresentationToFile((tmp / (base + suffix)).string());
+				for (const auto& e : fs::directory_iterator(tmp)) fs::rename(e.path(), fs::path(dir) / e.path().filename());
+				fs::remove_all(tmp);
+			});
 		}
 	}
+	if (failures > 1) firstError += " (and " + std::to_string(failures - 1) + " more map files not written)";
+	if (!firstError.empty()) throw std::runtime_error(firstError);
 	return files;
 }
 

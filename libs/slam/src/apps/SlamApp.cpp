@@ -10,13 +10,12 @@
 #include <keygrid/slam/LivePreview.h>
 #include <keygrid/slam/LiveRun.h>
 #include <keygrid/slam/ProcessMemory.h>
-#include <keygrid/slam/SceneExport.h>
-#include <keygrid/slam/SimpleMapExport.h>
 #include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/System.h>
 #include <keygrid/store/SessionStore.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/BatchExperiment.h>
+#include <keygrid/slam/apps/RunOutputs.h>
 #include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/vector_loadsave.h>
@@ -37,14 +36,6 @@ namespace
 {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-std::string trajectoryText(const core::Trajectory& t, const std::string& header)
-{
-	std::ostringstream o;
-	o << "# " << header << "\n# timestamp tx ty tz qx qy qz qw  (T_world_cam, optical frame)\n";
-	for (const auto& p : t) o << core::tumLine(p) << "\n";
-	return o.str();
-}
 
 std::string jsonEscape(const std::string& s)
 {
@@ -315,121 +306,12 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 			std::cerr << "keygrid-slam: warning: the new map never met the stored one; its " << ex.waitingForMerge
 					  << " keyframes are in a frame of their own, not in the metric maps nor in " << o.loadMap << "\n";
 	}
-	core::writeFileAtomically(o.output + "/trajectory.txt", trajectoryText(traj, trajectoryTitle));
+	RunOutputs outputs(o.output);
 	// The run's floor frame (any map configured): every map output is written in it.
-	const std::optional<mrpt::poses::CPose3D> T_world_floor =
-		sys.metricMaps() ? sys.metricMaps()->T_world_floor() : std::nullopt;
-	if (T_world_floor)
-	{
-		std::ostringstream t;
-		t << "# keygrid-slam trajectory in the floor frame (z up, z = 0 on the floor), every frame\n# "
-		  << maps::floorFrameComment(*T_world_floor) << "\n# timestamp tx ty tz qx qy qz qw  (T_floor_cam, optical frame)\n";
-		for (const auto& p : traj) t << core::tumLine({p.t, p.T_world_cam - *T_world_floor}) << "\n";
-		core::writeFileAtomically(o.output + "/trajectory_floor.txt", t.str());
-	}
-	{
-		// As tracked, before later map refinement (diagnostics: trajectory.txt is the final one).
-		core::Trajectory raw;
-		for (const auto& f : sys.frames()) raw.push_back({f.timestamp, f.T_world_cam});
-		core::writeFileAtomically(o.output + "/trajectory_online.txt", trajectoryText(raw, "keygrid-slam online poses (as tracked)"));
-	}
-	{
-		std::ostringstream csv;
-		// Localization mode: a last column says whether each frame was localized in the map.
-		csv << "index,timestamp,tracked,method,matches,inliers,new_keyframe,reference_keyframe,landmarks"
-			<< (sys.localizeOnly() ? ",status\n" : "\n");
-		for (const auto& f : sys.frames())
-		{
-			char line[180];
-			std::snprintf(line, sizeof(line), "%zu,%.6f,%d,%s,%d,%d,%d,%lld,%zu%s\n", f.index, f.timestamp, f.tracked ? 1 : 0,
-						  f.method.c_str(), f.matches, f.inliers, f.newKeyFrame ? 1 : 0,
-						  f.hasReference ? static_cast<long long>(f.reference) : -1LL, f.mapLandmarks,
-						  !sys.localizeOnly() ? "" : f.tracked ? ",localized" : ",lost");
-			csv << line;
-		}
-		core::writeFileAtomically(o.output + "/frames.csv", csv.str());
-	}
-	core::writeFileAtomically(o.output + "/keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
-	try
-	{
-		// A loaded map's keyframes have their images in the session file, not here.
-		if (!sys.localizeOnly()) writeKeyframesSimpleMap(sys.map(), sys.keyFrameImages(), o.output + "/keyframes.simplemap");
-	}
-	catch (const std::exception& e)
-	{
-		if (res.error.empty()) res.error = std::string("writing keyframes.simplemap: ") + e.what();
-	}
-	try
-	{
-		writeRunScene(traj, sys.map(), sys.metricMaps() ? &sys.metricMaps()->maps() : nullptr, T_world_floor, o.output + "/scene.3Dscene");
-	}
-	catch (const std::exception& e)
-	{
-		if (res.error.empty()) res.error = std::string("writing scene.3Dscene: ") + e.what();
-	}
-
-	if (sys.loopCloser())
-	{
-		// Why each keyframe did or did not close a loop (doc/loop-closure.md, "Diagnostics").
-		std::ostringstream csv;
-		csv << "keyframe,frame,outcome,reference_score,candidates,best_candidate,best_score,verified_candidate,matches,inliers,query_ms,seen_through\n";
-		for (const auto& q : sys.loopCloser()->queries())
-		{
-			char line[256];
-			std::snprintf(line, sizeof(line), "%llu,%zu,%s,%.4f,%d,%s,%.4f,%s,%d,%d,%.3f,%.4f\n", static_cast<unsigned long long>(q.keyframe),
-						  q.frameIndex, q.outcome.c_str(), q.referenceScore, q.candidates,
-						  q.candidates ? std::to_string(q.bestCandidate).c_str() : "", q.bestScore,
-						  q.verifiedCandidate ? std::to_string(*q.verifiedCandidate).c_str() : "", q.matches, q.inliers,
-						  1e3 * q.querySeconds, q.seenThroughRatio);
-			csv << line;
-		}
-		try
-		{
-			core::writeFileAtomically(o.output + "/loop_queries.csv", csv.str());
-		}
-		catch (const std::exception& e)
-		{
-			if (res.error.empty()) res.error = std::string("writing loop_queries.csv: ") + e.what();
-		}
-	}
-	if (sys.loopCloser() && sys.loopCloser()->lastPoseGraph())
-	{
-		try
-		{
-			sys.loopCloser()->lastPoseGraph()->writeG2o(o.output + "/posegraph.g2o");
-		}
-		catch (const std::exception& e)
-		{
-			if (res.error.empty()) res.error = std::string("writing posegraph.g2o: ") + e.what();
-		}
-	}
-	std::vector<std::string> mapFiles;
-	if (sys.metricMaps())
-	{
-		try
-		{
-			mapFiles = sys.metricMaps()->writeOutputs(o.output);
-		}
-		catch (const std::exception& e)
-		{
-			if (res.error.empty()) res.error = std::string("writing maps: ") + e.what();
-		}
-	}
-	// The HOC landmarks are written also when no hocPointsMap is configured.
-	const bool hocMapConfigured = sys.metricMaps() && sys.metricMaps()->maps().mapByClass<CHOCPointsMap>();
-	if (cfg.tracker.hoc.enabled && !hocMapConfigured)
-	{
-		try
-		{
-			hocPointsFromLandmarks(sys.map(), cfg.tracker.hoc)
-				.saveAsPly(o.output + "/hoc_points.ply.tmp", T_world_floor ? maps::floorExportFrame(*T_world_floor) : maps::ExportFrame{});
-			std::rename((o.output + "/hoc_points.ply.tmp").c_str(), (o.output + "/hoc_points.ply").c_str());
-		}
-		catch (const std::exception& e)
-		{
-			if (res.error.empty()) res.error = std::string("writing hoc_points.ply: ") + e.what();
-		}
-	}
+	std::optional<mrpt::poses::CPose3D> T_world_floor;
+	if (sys.metricMaps()) T_world_floor = sys.metricMaps()->T_world_floor();
+	writeRunFiles(sys, cfg, {traj, trajectoryTitle, T_world_floor, cfg.tracker.hoc.enabled}, outputs);
+	if (res.error.empty() && !outputs.errors().empty()) res.error = outputs.errors().front();
 	res.frames = sys.stats().frames;
 	res.tracked = sys.stats().tracked;
 	res.fps = res.frames / std::max(wall, 1e-9);
@@ -585,9 +467,14 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		}
 		js << "  \"gt_matched\": " << errs->matched << ",\n";
 	}
+	js << "  \"output_errors\": [";
+	for (std::size_t i = 0; i < outputs.errors().size(); i++) js << (i ? ", " : "") << "\"" << jsonEscape(outputs.errors()[i]) << "\"";
+	js << "],\n";
 	js << "  \"error\": " << (res.error.empty() ? "null" : "\"" + jsonEscape(res.error) + "\"") << "\n";
 	js << "}\n";
-	core::writeFileAtomically(o.output + "/report.json", js.str());
+	outputs.text("report.json", js.str());
+	res.outputErrors = outputs.errors();
+	if (res.error.empty() && !res.outputErrors.empty()) res.error = res.outputErrors.front();
 	return res;
 }
 
@@ -695,7 +582,13 @@ int SlamApp::run(int argc, const char* const* argv)
 		std::printf("\noutputs in %s\n", o.output.c_str());
 		if (!r.error.empty())
 		{
-			std::fprintf(stderr, "keygrid-slam: error: %s (outputs of the %zu frames before it were written)\n", r.error.c_str(), r.frames);
+			// A failure in the run (input, processing) first, then files that could not be written.
+			const bool runFailed = r.outputErrors.empty() || r.error != r.outputErrors.front();
+			if (runFailed)
+				std::fprintf(stderr, "keygrid-slam: error: %s (outputs of the %zu frames before it were written)\n", r.error.c_str(), r.frames);
+			if (!r.outputErrors.empty())
+				std::fprintf(stderr, "keygrid-slam: error: %s%s\n", r.outputErrors.front().c_str(),
+							 r.outputErrors.size() > 1 ? (" (and " + std::to_string(r.outputErrors.size() - 1) + " more files not written)").c_str() : "");
 			return 1;
 		}
 		// Shell convention for a run ended by a signal (130 = Ctrl-C), though it finished cleanly.

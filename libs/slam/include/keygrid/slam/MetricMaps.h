@@ -97,15 +97,14 @@ class MetricMaps
 	 * hoc_points.bin, readable with CFileGZInputStream + archiveFrom >> map); map_3d.* and
 	 * hoc_points.ply are in the floor frame when there is one (their comment line records
 	 * T_world_floor), the .bin files in the SLAM world; each file appears
-	 * atomically (written in DIR/.maps.tmp, then renamed);
-	 * returns the file names written. */
+	 * atomically. Every file is tried; the first that cannot be written is thrown as a
+	 * std::runtime_error naming it, after the others. Returns the file names written. */
 	std::vector<std::string> writeOutputs(const std::string& dir) const;
 	/** JSON array describing each map (class, size, outputs). */
 	std::string summaryJson() const;
 
    private:
 	MetricMaps(const MapFeedOptions& feed, const maps::FloorFrameOptions& floor) : m_feed(feed), m_floor(floor) {}
-	std::vector<std::string> writeOutputsInto(const std::string& dir) const;
 
 	mrpt::maps::CMultiMetricMap m_maps;
 	MapFeedOptions m_feed;

@@ -7,6 +7,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace keygrid::slam
 {
@@ -39,7 +40,11 @@ struct SlamRunResult
 	std::size_t frames{0}, tracked{0};
 	double fps{0};
 	std::optional<double> ateRmse;
-	std::string error;  //!< non-empty when the input failed part-way (outputs still written)
+	/** The first problem: the input or the processing failed part-way (the outputs are still
+	 * written), or else the first output file that could not be written. Empty: success. */
+	std::string error;
+	/** Output files that could not be written, each error naming its file */
+	std::vector<std::string> outputErrors;
 	/** The frame loop was stopped by interruptRequested() (Ctrl-C / SIGTERM) */
 	bool interrupted{false};
 	std::size_t liveGrabbed{0}, liveDropped{0};  //!< live runs: camera frames, and those skipped

@@ -1,0 +1,58 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (tests/fuzz/CMakeLists.txt, clang) and fuzzes each for a while,
+# starting from seeds made by keygrid's own writers plus the regression corpus
+# (tests/fuzz/corpus/<target>/: inputs that once crashed, kept so they are replayed).
+#
+#   bash tests/fuzz/run.sh [--seconds N] [--build DIR] [--targets "rawlog tum ini png"]
+#
+# Prints per target the executions, exec/s and coverage (libFuzzer's cov / ft); exits 1 when a
+# target crashes, leaks, hangs (-timeout) or trips a sanitizer, naming the input that did it.
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+src="$(cd "$here/../.." && pwd)"
+seconds=60
+build="$src/build-fuzz"
+targets="rawlog tum ini png"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --seconds) seconds="$2"; shift 2 ;;
+    --build) build="$2"; shift 2 ;;
+    --targets) targets="$2"; shift 2 ;;
+    -h|--help) sed -n '2,10p' "$0"; exit 0 ;;
+    *) echo "run.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+  esac
+done
+command -v clang++ >/dev/null || { echo "run.sh: clang++ missing (Debian: clang, libclang-rt-14-dev)" >&2; exit 2; }
+
+CXX=clang++ cmake -S "$here" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
+cmake --build "$build" -j2 >/dev/null
+seeds="$build/seeds"
+rm -rf "$seeds"
+ASAN_OPTIONS=detect_leaks=0 "$build/keygrid_fuzz_make_seeds" "$seeds" "$src"
+
+status=0
+export ASAN_OPTIONS="detect_leaks=0:allocator_may_return_null=1:malloc_limit_mb=2048"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+for t in $targets; do
+  work="$build/work/$t"
+  artifacts="$build/artifacts/$t"  # kept across runs: crashes to add to corpus/$t
+  rm -rf "$work"; mkdir -p "$work/corpus" "$artifacts"
+  cp -r "$seeds/$t/." "$work/corpus/"
+  [ -d "$here/corpus/$t" ] && cp -r "$here/corpus/$t/." "$work/corpus/"
+  log="$work/fuzz.log"
+  if (cd "$work" && "$build/fuzz_$t" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -seed=1 \
+        -max_len=1048576 -artifact_prefix="$artifacts/" -print_final_stats=1 corpus >"$log" 2>&1); then
+    result=ok
+  else
+    result=FAILED; status=1
+  fi
+  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
+  speed=$(grep -o 'stat::average_exec_per_sec: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
+  cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$log" | tail -1 || true)
+  printf 'fuzz_%-7s %-6s %10s execs  %7s exec/s  %s  (%s s)\n' "$t" "$result" "$runs" "$speed" "$cov" "$seconds"
+  if [ "$result" = FAILED ]; then
+    grep -E 'ERROR|SUMMARY|Test unit written' "$log" | head -5
+    echo "  log: $log"
+  fi
+done
+exit $status
