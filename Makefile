@@ -1,13 +1,14 @@
 # keygrid — the two commands users need, plus a few for developers.
 #   make demo   install dependencies, build Release, run the demo job
 #   make test   install dependencies, build, run the test suite (ctest)
+#   make fuzz   fuzz the input parsers (libFuzzer, FUZZ_SECONDS per parser)
 # Build trees: build/ (Release), build-asan/ (ASan + UBSan).
 BUILD_DIR ?= build
 ASAN_DIR  ?= build-asan
 JOBS      ?= 2
 CMAKE_ARGS ?=
 
-.PHONY: all deps configure build test demo sanitize test-sanitize ini-reference clean
+.PHONY: all deps configure build test demo sanitize test-sanitize fuzz ini-reference clean
 
 all: build
 
@@ -36,6 +37,12 @@ sanitize: deps
 test-sanitize: sanitize
 	ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
 	  ctest --test-dir $(ASAN_DIR) --output-on-failure -j$(JOBS)
+
+# Coverage-guided fuzzing of the input parsers (rawlog, TUM lists, INI, PNG) with libFuzzer:
+# FUZZ_SECONDS per parser; exits non-zero on any crash (tests/fuzz/run.sh).
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	bash tests/fuzz/run.sh --seconds $(FUZZ_SECONDS)
 
 # doc/ini-reference.md from the options structs (checked by the test IniReference.MatchesCommittedFile).
 ini-reference: configure

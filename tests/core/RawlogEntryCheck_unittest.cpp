@@ -10,6 +10,7 @@
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <algorithm>
 #include <cstring>
 
 using namespace keygrid::core;
@@ -147,10 +148,33 @@ TEST(RawlogEntryCheck, ADamagedCountClaimsNoMoreMemoryThanTheDataThere)
 	while (n + 4 <= bytes.size() && std::memcmp(bytes.data() + n, &fifty, 4) != 0) n++;
 	ASSERT_LT(n, bytes.size());
 	bytes[n + 3] = 0x40;
+	{
+		// Over the point bound: named.
+		mrpt::io::CMemoryStream in;
+		in.assignMemoryNotOwn(bytes.data(), bytes.size());
+		std::vector<std::uint8_t> head;
+		EXPECT_EQ(checkRawlogEntry(in, head, RawlogEntryLimits{}), "CObservation3DRangeScan declares 1073741874 3D points (more than 67108864)");
+	}
+	// Without the bound: the check reads what is there and stops.
 	mrpt::io::CMemoryStream in;
 	in.assignMemoryNotOwn(bytes.data(), bytes.size());
 	std::vector<std::uint8_t> head;
-	EXPECT_EQ(checkRawlogEntry(in, head, RawlogEntryLimits{}), "");
+	RawlogEntryLimits unbounded;
+	unbounded.maxPoints = UINT64_MAX;
+	EXPECT_EQ(checkRawlogEntry(in, head, unbounded), "");
 	EXPECT_EQ(head.size(), bytes.size());
 	EXPECT_LE(head.capacity(), 2 * bytes.size() + (std::size_t{1} << 21));
+}
+
+TEST(RawlogEntryCheck, ADamagedSensorPoseClassNameIsWalkedPastAsMrptReadsIt)
+{
+	// MRPT reads the sensor pose into an existing CPose3D without checking the class name: the
+	// range image size after it must still be checked (found by fuzz_rawlog).
+	auto bytes = serialize(*observation(0));
+	const std::string name = "mrpt::poses::CPose3D";
+	const auto it = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
+	ASSERT_NE(it, bytes.end());
+	*(it + 7) = 'w';  // "mrpt::pwses::CPose3D"
+	bytes[rowsColsOffset(bytes) + 7] = 0x7f;
+	EXPECT_NE(check(bytes).find("a side over 32768"), std::string::npos) << check(bytes);
 }

@@ -40,6 +40,7 @@ for t in $targets; do
   cp -r "$seeds/$t/." "$work/corpus/"
   [ -d "$here/corpus/$t" ] && cp -r "$here/corpus/$t/." "$work/corpus/"
   log="$work/fuzz.log"
+  t0=$(date +%s)
   if (cd "$work" && "$build/fuzz_$t" -max_total_time="$seconds" -timeout=20 -rss_limit_mb=2560 -seed=1 \
         -max_len=1048576 -artifact_prefix="$artifacts/" -print_final_stats=1 corpus >"$log" 2>&1); then
     result=ok
@@ -49,7 +50,7 @@ for t in $targets; do
   runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
   speed=$(grep -o 'stat::average_exec_per_sec: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
   cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$log" | tail -1 || true)
-  printf 'fuzz_%-7s %-6s %10s execs  %7s exec/s  %s  (%s s)\n' "$t" "$result" "$runs" "$speed" "$cov" "$seconds"
+  printf 'fuzz_%-7s %-6s %10s execs  %7s exec/s  %s  (%s s)\n' "$t" "$result" "$runs" "$speed" "$cov" "$(( $(date +%s) - t0 ))"
   if [ "$result" = FAILED ]; then
     grep -E 'ERROR|SUMMARY|Test unit written' "$log" | head -5
     echo "  log: $log"

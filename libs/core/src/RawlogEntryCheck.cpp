@@ -71,16 +71,19 @@ std::uint64_t left(const RawlogEntryLimits& l, const Reader& r, std::size_t star
 }
 
 // CObservation3DRangeScan (versions 9, 10) up to its range image size:
-//   float maxRange, CPose3D sensorPose (an object: header, 12 doubles, end byte 0x88),
+//   float maxRange, CPose3D sensorPose (an object: header, 12 or 7 doubles, end byte 0x88),
 //   bool hasPoints3D [uint32 N, 3 x N float, 2 x N uint16], bool hasRangeImage,
 //   float rangeUnits [uint32 rows, uint32 cols, rows x cols uint16].
 std::string checkRangeScan(Reader& r, std::uint8_t version, const RawlogEntryLimits& l, std::size_t start)
 {
 	if (version < 9 || version > 10) return {};
 	if (!r.value<float>()) return {};
+	// The sensor pose is read into an existing CPose3D: MRPT does not check the class name, so
+	// neither does this walk. Version 3: translation + rotation matrix (12 doubles), 2:
+	// translation + quaternion (7); older ones nest a matrix object (not walked).
 	const auto pose = r.header();
-	if (!pose || !isClass(pose->first, "mrpt::poses", "CPose3D") || pose->second != 3) return {};
-	if (!r.bytes(12 * sizeof(double))) return {};
+	if (!pose || (pose->second != 2 && pose->second != 3)) return {};
+	if (!r.bytes((pose->second == 3 ? 12 : 7) * sizeof(double))) return {};
 	const auto end = r.value<std::uint8_t>();
 	if (!end || *end != 0x88) return {};
 	const auto hasPoints = r.value<std::uint8_t>();
@@ -90,6 +93,8 @@ std::string checkRangeScan(Reader& r, std::uint8_t version, const RawlogEntryLim
 		const auto n = r.value<std::uint32_t>();
 		if (!n) return {};
 		const std::uint64_t bytes = std::uint64_t{*n} * (3 * sizeof(float) + 2 * sizeof(std::uint16_t));
+		if (*n > l.maxPoints)
+			return "CObservation3DRangeScan declares " + std::to_string(*n) + " 3D points (more than " + std::to_string(l.maxPoints) + ")";
 		if (bytes > left(l, r, start))
 			return "CObservation3DRangeScan declares " + std::to_string(*n) + " 3D points (" + std::to_string(bytes) +
 				   " bytes), more than the " + std::to_string(left(l, r, start)) + " bytes left in the file";
@@ -103,7 +108,9 @@ std::string checkRangeScan(Reader& r, std::uint8_t version, const RawlogEntryLim
 	const std::string size = std::to_string(*cols) + " x " + std::to_string(*rows);
 	if (*rows > l.maxImageSide || *cols > l.maxImageSide)
 		return "CObservation3DRangeScan range image of " + size + " pixels (a side over " + std::to_string(l.maxImageSide) + ")";
-	const std::uint64_t bytes = std::uint64_t{*rows} * *cols * sizeof(std::uint16_t);
+	const std::uint64_t pixels = std::uint64_t{*rows} * *cols, bytes = pixels * sizeof(std::uint16_t);
+	if (pixels > l.maxImagePixels)
+		return "CObservation3DRangeScan range image of " + size + " pixels (more than " + std::to_string(l.maxImagePixels) + ")";
 	if (bytes > left(l, r, start))
 		return "CObservation3DRangeScan range image of " + size + " pixels needs " + std::to_string(bytes) +
 			   " bytes, more than the " + std::to_string(left(l, r, start)) + " bytes left in the file";

@@ -112,7 +112,9 @@ bool RawlogFrameSource::next(Frame& out)
 		// (RawlogEntryCheck.h); the bytes read for that are replayed to the deserializer.
 		std::vector<std::uint8_t> head;
 		RawlogEntryLimits limits;
-		if (!m_compressed) limits.bytesLeft = m_fileSize > posBefore ? m_fileSize - posBefore : 0;
+		// Positions count uncompressed bytes; a gzip file inflates to at most 1032 times its size.
+		const std::uint64_t size = m_compressed ? std::uint64_t{m_fileSize} * 1032 : m_fileSize;
+		limits.bytesLeft = size > posBefore ? size - posBefore : 0;
 		const std::string damaged = checkRawlogEntry(m_impl->file, head, limits);
 		if (!damaged.empty())
 		{

@@ -25,6 +25,7 @@
 #include <keygrid/eval/Alignment.h>
 #include <mrpt/math/CMatrixFixed.h>
 #include <mrpt/poses/CPose3DQuat.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -72,33 +73,31 @@ struct Estimate
 	mrpt::poses::CPose3D T_world_floor;
 };
 
-mrpt::poses::CPose3D poseFromJson(const std::string& arr)
+/** [x, y, z, qx, qy, qz, qw] as a pose. */
+mrpt::poses::CPose3D poseFromJson(const nlohmann::json& a)
 {
-	std::istringstream is(std::regex_replace(arr, std::regex("[\\[\\],]"), " "));
-	double x, y, z, qx, qy, qz, qw;
-	if (!(is >> x >> y >> z >> qx >> qy >> qz >> qw)) throw std::runtime_error("bad pose " + arr);
-	return mrpt::poses::CPose3D(mrpt::poses::CPose3DQuat(x, y, z, mrpt::math::CQuaternionDouble(qw, qx, qy, qz)));
+	if (!a.is_array() || a.size() != 7) throw std::runtime_error("bad pose " + a.dump());
+	const auto v = a.get<std::vector<double>>();
+	return mrpt::poses::CPose3D(mrpt::poses::CPose3DQuat(v[0], v[1], v[2], mrpt::math::CQuaternionDouble(v[6], v[3], v[4], v[5])));
 }
 
-/** The history and the final estimate of report.json's "floor" object. */
-std::vector<Estimate> readEstimates(const std::string& path)
+nlohmann::json readReport(const std::string& path)
 {
 	std::ifstream f(path);
 	if (!f) throw std::runtime_error("cannot read " + path);
-	std::stringstream ss;
-	ss << f.rdbuf();
-	const std::string js = ss.str();
-	const auto at = js.find("\"floor\": {");
-	if (at == std::string::npos) throw std::runtime_error(path + " has no floor frame");
-	const std::string fl = js.substr(at, js.find('\n', at) - at);
+	return nlohmann::json::parse(f);
+}
+
+/** The history and the final estimate of report.json's "floor" object. */
+std::vector<Estimate> readEstimates(const nlohmann::json& report, const std::string& path)
+{
+	if (!report.contains("floor") || !report["floor"].is_object()) throw std::runtime_error(path + " has no floor frame");
+	const auto& fl = report["floor"];
 	std::vector<Estimate> out;
-	const std::regex entry("\\{\"keyframes\": (\\d+), \"stamp\": ([0-9.eE+-]+)[^{]*?\"T_world_floor\": (\\[[^\\]]*\\])");
-	for (auto it = std::sregex_iterator(fl.begin(), fl.end(), entry); it != std::sregex_iterator(); ++it)
-		out.push_back({std::stol((*it)[1]), std::stod((*it)[2]), poseFromJson((*it)[3])});
-	std::smatch m;
-	if (!std::regex_search(fl, m, std::regex("\"T_world_floor\": (\\[[^\\]]*\\])")))
-		throw std::runtime_error(path + ": the run has no floor frame");
-	out.push_back({-1, 0.0, poseFromJson(m[1])});
+	for (const auto& h : fl.value("history", nlohmann::json::array()))
+		out.push_back({h.at("keyframes").get<long>(), h.at("stamp").get<double>(), poseFromJson(h.at("T_world_floor"))});
+	if (!fl.contains("T_world_floor") || fl["T_world_floor"].is_null()) throw std::runtime_error(path + ": the run has no floor frame");
+	out.push_back({-1, 0.0, poseFromJson(fl["T_world_floor"])});
 	return out;
 }
 
@@ -165,17 +164,11 @@ int main(int argc, char** argv)
 				}
 			return n ? Eigen::Vector3d(c / static_cast<double>(n)) : centroidAll;
 		};
-		const auto estimates = readEstimates(reportPath);
+		const auto report = readReport(reportPath);
+		const auto estimates = readEstimates(report, reportPath);
 		double firstLoop = 1e300;
-		{
-			std::ifstream f(reportPath);
-			std::stringstream ss;
-			ss << f.rdbuf();
-			std::smatch m;
-			const std::string js = ss.str();
-			if (std::regex_search(js, m, std::regex("\"loop_closures\": \\[\\{[^}]*\"keyframe_timestamp\": ([0-9.eE+-]+)")))
-				firstLoop = std::stod(m[1]);
-		}
+		if (const auto& loops = report.value("loop_closures", nlohmann::json::array()); !loops.empty())
+			firstLoop = loops[0].at("keyframe_timestamp").get<double>();
 		// The estimate in force at 10 keyframes: the last one from at most 10 (an unchanged
 		// estimate is not repeated), else the first one after.
 		const Estimate* at10 = nullptr;

@@ -1,10 +1,10 @@
 /** \file BatchResults.cpp
- * report.json reading (a small strict JSON reader: keygrid has no JSON dependency) and the
- * results tables of keygrid-batch.
+ * report.json reading and the results tables of keygrid-batch.
  */
 #include <keygrid/slam/apps/BatchResults.h>
 #include <mrpt/io/vector_loadsave.h>
 #include <mrpt/system/filesystem.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -17,167 +17,13 @@ namespace keygrid::slam
 {
 namespace
 {
-/** A JSON value; only what report.json needs is kept (numbers, strings, array lengths). */
-struct JsonValue
+using Json = nlohmann::json;
+
+std::optional<double> numberOf(const Json& obj, const char* key)
 {
-	enum class Type
-	{
-		Null,
-		Bool,
-		Number,
-		String,
-		Array,
-		Object
-	} type{Type::Null};
-	double number{0};
-	std::string text;
-	std::size_t arraySize{0};
-	std::map<std::string, JsonValue> members;
-};
-
-class JsonReader
-{
-   public:
-	explicit JsonReader(const std::string& s) : m_s(s) {}
-
-	JsonValue document()
-	{
-		JsonValue v = value();
-		blanks();
-		if (m_i != m_s.size()) fail("trailing characters");
-		return v;
-	}
-
-   private:
-	const std::string& m_s;
-	std::size_t m_i{0};
-
-	[[noreturn]] void fail(const std::string& why) const
-	{
-		throw std::runtime_error("invalid JSON at offset " + std::to_string(m_i) + ": " + why);
-	}
-	void blanks()
-	{
-		while (m_i < m_s.size() && (m_s[m_i] == ' ' || m_s[m_i] == '\n' || m_s[m_i] == '\t' || m_s[m_i] == '\r')) m_i++;
-	}
-	bool take(char c)
-	{
-		blanks();
-		if (m_i < m_s.size() && m_s[m_i] == c)
-		{
-			m_i++;
-			return true;
-		}
-		return false;
-	}
-	void expect(char c)
-	{
-		if (!take(c)) fail(std::string("expected '") + c + "'");
-	}
-	bool word(const char* w)
-	{
-		const std::size_t n = std::char_traits<char>::length(w);
-		if (m_s.compare(m_i, n, w) != 0) return false;
-		m_i += n;
-		return true;
-	}
-	std::string string()
-	{
-		expect('"');
-		std::string o;
-		while (m_i < m_s.size() && m_s[m_i] != '"')
-		{
-			char c = m_s[m_i++];
-			if (c == '\\')
-			{
-				if (m_i >= m_s.size()) break;
-				c = m_s[m_i++];
-				switch (c)
-				{
-					case 'n': c = '\n'; break;
-					case 't': c = '\t'; break;
-					case 'r': c = '\r'; break;
-					case 'b': c = '\b'; break;
-					case 'f': c = '\f'; break;
-					case 'u':
-						// Non-ASCII escapes are not produced by keygrid; keep them as '?'.
-						if (m_i + 4 > m_s.size()) fail("short \\u escape");
-						m_i += 4;
-						c = '?';
-						break;
-					default: break;  // '"', '\\', '/'
-				}
-			}
-			o += c;
-		}
-		if (m_i >= m_s.size()) fail("unterminated string");
-		m_i++;
-		return o;
-	}
-	JsonValue value()
-	{
-		blanks();
-		if (m_i >= m_s.size()) fail("unexpected end");
-		JsonValue v;
-		const char c = m_s[m_i];
-		if (c == '{')
-		{
-			m_i++;
-			v.type = JsonValue::Type::Object;
-			if (take('}')) return v;
-			do
-			{
-				blanks();
-				const std::string k = string();
-				expect(':');
-				v.members[k] = value();
-			} while (take(','));
-			expect('}');
-		}
-		else if (c == '[')
-		{
-			m_i++;
-			v.type = JsonValue::Type::Array;
-			if (take(']')) return v;
-			do
-			{
-				value();
-				v.arraySize++;
-			} while (take(','));
-			expect(']');
-		}
-		else if (c == '"')
-		{
-			v.type = JsonValue::Type::String;
-			v.text = string();
-		}
-		else if (word("null"))
-			v.type = JsonValue::Type::Null;
-		else if (word("true"))
-		{
-			v.type = JsonValue::Type::Bool;
-			v.number = 1;
-		}
-		else if (word("false"))
-			v.type = JsonValue::Type::Bool;
-		else
-		{
-			const char* begin = m_s.c_str() + m_i;
-			char* end = nullptr;
-			v.number = std::strtod(begin, &end);
-			if (end == begin) fail("unexpected character");
-			v.type = JsonValue::Type::Number;
-			m_i += static_cast<std::size_t>(end - begin);
-		}
-		return v;
-	}
-};
-
-std::optional<double> numberOf(const JsonValue& obj, const std::string& key)
-{
-	const auto it = obj.members.find(key);
-	if (it == obj.members.end() || it->second.type != JsonValue::Type::Number) return std::nullopt;
-	return it->second.number;
+	const auto it = obj.find(key);
+	if (it == obj.end() || !it->is_number()) return std::nullopt;
+	return it->get<double>();
 }
 
 std::string fmt(const std::optional<double>& v, const char* f)
@@ -211,16 +57,16 @@ std::string mdCell(const std::string& s)
 RunMetrics readRunReport(const std::string& reportPath)
 {
 	if (!mrpt::system::fileExists(reportPath)) throw std::runtime_error("no " + reportPath);
-	JsonValue doc;
+	Json doc;
 	try
 	{
-		doc = JsonReader(mrpt::io::file_get_contents(reportPath)).document();
+		doc = Json::parse(mrpt::io::file_get_contents(reportPath));
 	}
 	catch (const std::exception& e)
 	{
 		throw std::runtime_error(reportPath + ": " + e.what());
 	}
-	if (doc.type != JsonValue::Type::Object) throw std::runtime_error(reportPath + ": not a JSON object");
+	if (!doc.is_object()) throw std::runtime_error(reportPath + ": not a JSON object");
 	RunMetrics m;
 	m.frames = numberOf(doc, "frames");
 	m.tracked = numberOf(doc, "tracked");
@@ -228,10 +74,12 @@ RunMetrics readRunReport(const std::string& reportPath)
 	m.ateRmse = numberOf(doc, "ate_rmse_m");
 	m.keyframes = numberOf(doc, "keyframes");
 	m.landmarks = numberOf(doc, "landmarks");
-	if (const auto it = doc.members.find("loop_closures"); it != doc.members.end() && it->second.type == JsonValue::Type::Array)
-		m.loopClosures = static_cast<double>(it->second.arraySize);
-	if (const auto it = doc.members.find("error"); it != doc.members.end() && it->second.type == JsonValue::Type::String)
-		m.error = it->second.text.empty() ? "error (no message)" : it->second.text;
+	if (const auto it = doc.find("loop_closures"); it != doc.end() && it->is_array()) m.loopClosures = static_cast<double>(it->size());
+	if (const auto it = doc.find("error"); it != doc.end() && it->is_string())
+	{
+		const auto text = it->get<std::string>();
+		m.error = text.empty() ? "error (no message)" : text;
+	}
 	return m;
 }
 

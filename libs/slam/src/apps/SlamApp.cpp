@@ -16,6 +16,7 @@
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/BatchExperiment.h>
 #include <keygrid/slam/apps/RunOutputs.h>
+#include <keygrid/slam/apps/SlamReport.h>
 #include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/vector_loadsave.h>
@@ -36,22 +37,6 @@ namespace
 {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-std::string jsonEscape(const std::string& s)
-{
-	std::string o;
-	for (char c : s)
-	{
-		if (c == '"' || c == '\\') o += '\\';
-		if (c == '\n')
-		{
-			o += "\\n";
-			continue;
-		}
-		o += c;
-	}
-	return o;
-}
 
 /** The configuration file's text with `set` applied (keys checked first: MRPT would ignore a
  * misspelt one). The file is read once, so every reader sees the same configuration. */
@@ -329,150 +314,8 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 		}
 	}
 
-	const auto& st = sys.stats();
-	std::ostringstream js;
-	js << "{\n";
-	js << "  \"input\": \"" << jsonEscape(live ? live->describe() : o.input) << "\",\n";
-	js << "  \"config\": \"" << jsonEscape(o.configPath) << "\",\n";
-	js << "  \"config_set\": " << (o.set.empty() ? "null" : "\"" + jsonEscape(o.set) + "\"") << ",\n";
-	js << "  \"mode\": \"" << cfg.mode << "\",\n";
-	js << "  \"frames\": " << st.frames << ",\n";
-	js << "  \"tracked\": " << st.tracked << ",\n";
-	js << "  \"lost\": " << st.lost << ",\n";
-	js << "  \"relocalizations\": " << st.relocalizations << ",\n";
-	js << "  \"relocalization_events\": [";
-	{
-		const char* sep = "";
-		for (const auto& f : sys.frames())
-			if (f.tracked && f.method == "relocalization")
-			{
-				js << sep << "{\"frame\": " << f.index << ", \"keyframe\": " << f.relocalizationKeyFrame
-				   << ", \"place_recognition\": " << (f.relocalizedByPlaceRecognition ? "true" : "false") << "}";
-				sep = ", ";
-			}
-	}
-	js << "],\n";
-	js << "  \"pnp_fallbacks\": " << st.pnpFallbacks << ",\n";
-	js << "  \"skipped_input_entries\": " << skipped << ",\n";
-	if (!lastSkip.empty()) js << "  \"last_skip_reason\": \"" << jsonEscape(lastSkip) << "\",\n";
-	js << "  \"interrupted\": " << (res.interrupted ? "true" : "false") << ",\n";
-	if (live) js << "  \"live\": {\"grabbed\": " << res.liveGrabbed << ", \"dropped\": " << res.liveDropped << "},\n";
-	js << "  \"keyframes\": " << sys.map().numKeyFrames() << ",\n";
-	js << "  \"keyframes_created\": " << st.keyframesCreated << ",\n";
-	js << "  \"keyframes_culled\": " << st.keyframesCulled << ",\n";
-	js << "  \"landmarks\": " << sys.map().numLandmarks() << ",\n";
-	js << "  \"landmarks_culled\": " << st.landmarksCulled << ",\n";
-	js << "  \"landmarks_fused\": " << st.landmarksFused << ",\n";
-	if (cfg.mode == "threaded") js << "  \"ba_discarded\": " << st.baDiscarded << ",\n";
-	if (cfg.tracker.hoc.enabled)
-		js << "  \"hoc\": {\"landmarks_pruned\": " << st.landmarksPrunedHoc << ", \"increments\": " << st.hocIncrements
-		   << ", \"decrements\": " << st.hocDecrements << ", \"occluded\": " << st.hocOccluded << ", \"recovered\": " << st.hocRecovered << ", \"seen_through\": " << st.hocSeenThrough << ", \"fallback_frames\": " << st.hocFallbackFrames << "},\n";
-	if (sys.loopCloser()) js << "  \"vocabulary\": \"" << jsonEscape(sys.loopCloser()->vocabularySource()) << "\",\n";
-	js << "  \"loop_closures\": [";
-	for (std::size_t i = 0; i < sys.loopClosures().size(); i++)
-	{
-		const auto& ev = sys.loopClosures()[i];
-		char l[512];
-		std::snprintf(l, sizeof(l),
-					  "%s{\"frame\": %zu, \"keyframe\": %llu, \"loop_keyframe\": %llu, \"keyframe_timestamp\": %.6f, \"loop_keyframe_timestamp\": %.6f, "
-					  "\"score\": %.4f, \"inliers\": %d, \"measured_distance_m\": %.4f, \"measured_angle_deg\": %.3f, \"correction_m\": %.4f, \"seconds\": %.4f}",
-					  i ? ", " : "", ev.frameIndex, static_cast<unsigned long long>(ev.keyframe), static_cast<unsigned long long>(ev.loopKeyFrame),
-					  ev.keyframeTimestamp, ev.loopKeyFrameTimestamp, ev.score, ev.inliers, ev.measuredDistance, ev.measuredAngleDeg, ev.correctionMetres, ev.seconds);
-		js << l;
-	}
-	js << "],\n";
-	// One "session" object: what was loaded, what was recorded, or both (extend mode).
-	if (loaded)
-	{
-		char l[400];
-		std::snprintf(l, sizeof(l),
-					  "  \"session\": {\"loaded\": \"%s\", \"mode\": \"%s\", \"keyframes\": %zu, \"landmarks\": %zu, \"load_s\": %.3f, "
-					  "\"localized\": %zu, \"lost\": %zu, \"localized_ratio\": %.4f",
-					  jsonEscape(o.loadMap).c_str(), o.localize ? "localize" : "extend", loaded->keyframes, loaded->landmarks, loaded->seconds,
-					  st.tracked, st.lost, st.frames ? static_cast<double>(st.tracked) / static_cast<double>(st.frames) : 0.0);
-		js << l;
-		if (!o.localize)
-		{
-			const auto ex = sys.extendState();
-			std::snprintf(l, sizeof(l), ", \"started\": \"%s\", \"maps_merged\": %zu, \"keyframes_waiting_for_merge\": %zu",
-						  ex.startedInStoredMap ? "in_stored_map" : ex.startedNewMap ? "new_map" : "never", st.mapsMerged, ex.waitingForMerge);
-			js << l;
-		}
-		js << (sys.recorder() ? ",\n    " : "},\n");
-	}
-	if (const SessionRecorder* rec = sys.recorder())
-	{
-		const auto rs = rec->stats();
-		const auto ws = rec->writerStats();
-		std::error_code ec;
-		const auto bytes = std::filesystem::file_size(rec->path(), ec);
-		char l[512];
-		std::snprintf(l, sizeof(l),
-					  "%s\"recorded\": \"%s\", \"updates\": %zu, \"keyframes_written\": %zu, \"landmarks_written\": %zu, "
-					  "\"snapshots\": %zu, \"build_ms_per_update\": %.3f, \"writer_encode_s\": %.3f, \"writer_commit_s\": %.3f, \"file_mb\": %.3f},\n",
-					  loaded ? "" : "  \"session\": {", jsonEscape(rec->path()).c_str(), rs.updates, rs.keyframesWritten, rs.landmarksWritten, rs.snapshots,
-					  rs.updates ? 1e3 * rs.buildSeconds / static_cast<double>(rs.updates) : 0.0, ws.encodeSeconds, ws.writeSeconds,
-					  ec ? 0.0 : static_cast<double>(bytes) / (1024.0 * 1024.0));
-		js << l;
-	}
-	js << "  \"maps\": " << (sys.metricMaps() ? sys.metricMaps()->summaryJson() : std::string("[]")) << ",\n";
-	js << "  \"floor\": " << (sys.metricMaps() ? sys.metricMaps()->floor().toJson() : std::string("null")) << ",\n";
-	{
-		char m[320];
-		const double kfs = std::max<std::size_t>(1, st.keyframesCreated);
-		std::snprintf(m, sizeof(m), "  \"mean_inliers\": %.1f,\n  \"mean_ba_keyframes\": %.1f,\n  \"mean_ba_observations\": %.1f,\n  \"mean_ba_outliers\": %.1f,\n  \"mean_ba_iterations\": %.2f,\n",
-					  st.sumInliers / std::max<std::size_t>(1, st.frames), st.sumBaKeyFrames / kfs, st.sumBaObservations / kfs, st.sumBaOutliers / kfs,
-					  st.sumBaIterations / kfs);
-		js << m;
-	}
-	if (const auto& ba = sys.globalBundleAdjustmentReport())
-	{
-		char g[256];
-		std::snprintf(g, sizeof(g), "  \"global_ba\": {\"keyframes\": %d, \"landmarks\": %d, \"observations\": %d, \"outliers\": %d, \"iterations\": %d, \"median_chi2\": %.4f},\n",
-					  ba->keyframes, ba->landmarks, ba->observations, ba->outliersRemoved, ba->iterations, ba->medianChi2);
-		js << g;
-	}
-	char b[64];
-	std::snprintf(b, sizeof(b), "%.3f", res.fps);
-	js << "  \"fps\": " << b << ",\n";
-	std::snprintf(b, sizeof(b), "%.3f", wall);
-	js << "  \"wall_time_s\": " << b << ",\n";
-	js << "  \"timings\": " << sys.timings().toJson(2) << ",\n";
-	{
-		// Memory, and how the per-frame cost evolves along the run (tests/benchmarks/slam/office_loop_memory.sh).
-		std::snprintf(b, sizeof(b), "%.1f", peakResidentMegabytes());
-		js << "  \"max_rss_mb\": " << b << ",\n";
-		js << "  \"rss_mb_by_keyframes\": " << memory.toJson() << ",\n";
-		js << "  \"track_and_map_ms_per_100_frames\": [";
-		const auto blocks = sys.timings().blockMeans("track_and_map", 100);
-		for (std::size_t i = 0; i < blocks.size(); i++)
-		{
-			std::snprintf(b, sizeof(b), "%s%.2f", i ? ", " : "", 1e3 * blocks[i]);
-			js << b;
-		}
-		js << "],\n";
-	}
-	if (errs)
-	{
-		std::snprintf(b, sizeof(b), "%.9g", errs->ate.rmse);
-		js << "  \"ate_rmse_m\": " << b << ",\n";
-		std::snprintf(b, sizeof(b), "%.9g", errs->ateRotDeg.rmse);
-		js << "  \"ate_rot_rmse_deg\": " << b << ",\n";
-		if (errs->rpeTrans)
-		{
-			std::snprintf(b, sizeof(b), "%.9g", errs->rpeTrans->rmse);
-			js << "  \"rpe_trans_m_per_s\": " << b << ",\n";
-			std::snprintf(b, sizeof(b), "%.9g", errs->rpeRotDeg->rmse);
-			js << "  \"rpe_rot_deg_per_s\": " << b << ",\n";
-		}
-		js << "  \"gt_matched\": " << errs->matched << ",\n";
-	}
-	js << "  \"output_errors\": [";
-	for (std::size_t i = 0; i < outputs.errors().size(); i++) js << (i ? ", " : "") << "\"" << jsonEscape(outputs.errors()[i]) << "\"";
-	js << "],\n";
-	js << "  \"error\": " << (res.error.empty() ? "null" : "\"" + jsonEscape(res.error) + "\"") << "\n";
-	js << "}\n";
-	outputs.text("report.json", js.str());
+	const SlamReportInput reportInput{o, cfg, res, live ? live->describe() : o.input, static_cast<bool>(live), loaded, wall, memory, errs, outputs.errors()};
+	outputs.text("report.json", slamReportJson(sys, reportInput));
 	res.outputErrors = outputs.errors();
 	if (res.error.empty() && !res.outputErrors.empty()) res.error = res.outputErrors.front();
 	return res;

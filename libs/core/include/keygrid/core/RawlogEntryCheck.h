@@ -25,10 +25,15 @@ namespace keygrid::core
 struct RawlogEntryLimits
 {
 	/** Bytes left in the stream after the entry's first byte; an entry declaring more data
-	 * than this is damaged. For a gzip rawlog (unknown uncompressed size) leave the maximum. */
+	 * than this is damaged. For a gzip rawlog (uncompressed size unknown): a bound such as
+	 * 1032 times the file size, DEFLATE's largest ratio. */
 	std::uint64_t bytesLeft{UINT64_MAX};
 	/** Largest range image side: 32768 is far beyond any depth camera. */
 	std::uint32_t maxImageSide{32768};
+	/** Most range image pixels (8192 x 8192) and 3D points: what a damaged count may make
+	 * MRPT allocate where bytesLeft is only a loose bound (gzip). */
+	std::uint64_t maxImagePixels{std::uint64_t{1} << 26};
+	std::uint64_t maxPoints{std::uint64_t{1} << 26};
 };
 
 /** Reads the head of the next serialized object from `in`, appending every byte read to
