@@ -5,6 +5,7 @@
  */
 #include <keygrid/core/RawlogEntryCheck.h>
 #include <gtest/gtest.h>
+#include <mrpt/img/CImage.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/obs/CSensoryFrame.h>
@@ -76,8 +77,8 @@ TEST(RawlogEntryCheck, IntactEntriesPassAndDeserializeThroughTheReplayedPrefix)
 		RawlogEntryLimits l;
 		l.bytesLeft = bytes.size();
 		EXPECT_EQ(checkRawlogEntry(in, head, l), "");
-		// The walk reached the range image size (it stops right after it).
-		EXPECT_EQ(head.size(), rowsColsOffset(bytes) + 8) << points << " points";
+		// The walk went past the range image: its size, its data, the two image flags.
+		EXPECT_EQ(head.size(), rowsColsOffset(bytes) + 8 + 30 * 40 * 2 + 2) << points << " points";
 		PrefixedStream replay(head, in);
 		EXPECT_EQ(replay.getPosition(), 0u);
 		auto back = std::dynamic_pointer_cast<CObservation3DRangeScan>(mrpt::serialization::archiveFrom(replay).ReadObject());
@@ -177,4 +178,40 @@ TEST(RawlogEntryCheck, ADamagedSensorPoseClassNameIsWalkedPastAsMrptReadsIt)
 	*(it + 7) = 'w';  // "mrpt::pwses::CPose3D"
 	bytes[rowsColsOffset(bytes) + 7] = 0x7f;
 	EXPECT_NE(check(bytes).find("a side over 32768"), std::string::npos) << check(bytes);
+
+	// MRPT finds the observation's class by the name after the last "::": a damaged namespace
+	// still makes a CObservation3DRangeScan.
+	bytes[7] = '[';  // "mrpt::o[s::CObservation3DRangeScan"
+	EXPECT_NE(check(bytes).find("a side over 32768"), std::string::npos) << check(bytes);
+}
+
+TEST(RawlogEntryCheck, AColourImageStoredAsJpegMustDecode)
+{
+	// MRPT stores colour images raw unless JPEG compression is switched on.
+	auto obs = observation(0);
+	obs->hasIntensityImage = true;
+	obs->intensityImage = mrpt::img::CImage(40, 30, mrpt::img::CH_RGB);
+	for (int y = 0; y < 30; y++)
+		for (int x = 0; x < 40; x++)
+		{
+			auto* p = obs->intensityImage.ptr<std::uint8_t>(x, y);
+			p[0] = static_cast<std::uint8_t>(6 * x);
+			p[1] = static_cast<std::uint8_t>(8 * y);
+			p[2] = 90;
+		}
+	EXPECT_EQ(check(serialize(*obs)), "") << "raw colour pixels";
+	const bool before = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+	const auto jpeg = serialize(*obs);
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(before);
+	const std::uint8_t soi[3] = {0xFF, 0xD8, 0xFF};
+	const auto at = std::search(jpeg.begin(), jpeg.end(), soi, soi + 3);
+	ASSERT_NE(at, jpeg.end()) << "a JPEG inside the entry";
+	EXPECT_EQ(check(jpeg), "");
+
+	// Not a JPEG any more: libjpeg would end the process; the check names it.
+	auto damaged = jpeg;
+	damaged[static_cast<std::size_t>(at - jpeg.begin())] = 0x14;
+	EXPECT_NE(check(damaged).find("intensity image: its "), std::string::npos) << check(damaged);
+	EXPECT_NE(check(damaged).find("bytes of JPEG data do not decode"), std::string::npos);
 }

@@ -9,9 +9,12 @@
  * the range image size, checks it, and hands the bytes it read back to the deserializer
  * through PrefixedStream, so the stream is read once.
  *
+ * A colour image stored as JPEG inside the entry is decoded first too: MRPT hands it to
+ * libjpeg with the default error handler, which ends the process (exit()) on a damaged stream.
+ *
  * Walked: a CObservation3DRangeScan (serialization versions 9 and 10, MRPT 2.x), at the top
- * level or as the first observation of a CSensoryFrame. Any other object, or a layout this
- * walker does not know, is passed on unchecked.
+ * level or as the first observation of a CSensoryFrame, up to its intensity and confidence
+ * images. Any other object, or a layout this walker does not know, is passed on unchecked.
  */
 #include <mrpt/io/CStream.h>
 
