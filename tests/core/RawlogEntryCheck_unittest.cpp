@@ -77,8 +77,9 @@ TEST(RawlogEntryCheck, IntactEntriesPassAndDeserializeThroughTheReplayedPrefix)
 		RawlogEntryLimits l;
 		l.bytesLeft = bytes.size();
 		EXPECT_EQ(checkRawlogEntry(in, head, l), "");
-		// The walk went past the range image: its size, its data, the two image flags.
-		EXPECT_EQ(head.size(), rowsColsOffset(bytes) + 8 + 30 * 40 * 2 + 2) << points << " points";
+		// The walk went to the end of the entry: all but its end-of-object byte.
+		EXPECT_EQ(head.size(), bytes.size() - 1) << points << " points";
+		EXPECT_EQ(bytes.back(), 0x88);
 		PrefixedStream replay(head, in);
 		EXPECT_EQ(replay.getPosition(), 0u);
 		auto back = std::dynamic_pointer_cast<CObservation3DRangeScan>(mrpt::serialization::archiveFrom(replay).ReadObject());
@@ -214,4 +215,30 @@ TEST(RawlogEntryCheck, AColourImageStoredAsJpegMustDecode)
 	damaged[static_cast<std::size_t>(at - jpeg.begin())] = 0x14;
 	EXPECT_NE(check(damaged).find("intensity image: its "), std::string::npos) << check(damaged);
 	EXPECT_NE(check(damaged).find("bytes of JPEG data do not decode"), std::string::npos);
+}
+
+TEST(RawlogEntryCheck, TheTailOfTheEntryIsWalkedToo)
+{
+	// An extra range image layer (version 10) with a damaged size: MRPT would write through a
+	// null allocation (found by fuzz_rawlog). And a sensor label of 4 GiB.
+	auto obs = observation(0);
+	obs->sensorLabel = "KINECT";
+	auto& layer = obs->rangeImageOtherLayers["ir"];
+	layer.resize(30, 40);
+	layer.fill(7);
+	const auto bytes = serialize(*obs);
+	EXPECT_EQ(check(bytes), "");
+	const std::string name = "ir";
+	const auto it = std::search(bytes.begin(), bytes.end(), name.begin(), name.end());
+	ASSERT_NE(it, bytes.end());
+	auto damaged = bytes;
+	damaged[static_cast<std::size_t>(it - bytes.begin()) + 2 + 3] = 0x7f;  // rows' high byte
+	EXPECT_NE(check(damaged).find("range image layer of"), std::string::npos) << check(damaged);
+
+	const std::string label = "KINECT";
+	const auto at = std::search(bytes.begin(), bytes.end(), label.begin(), label.end());
+	ASSERT_NE(at, bytes.end());
+	auto longLabel = bytes;
+	longLabel[static_cast<std::size_t>(at - bytes.begin()) - 1] = 0xff;  // the length's high byte
+	EXPECT_NE(check(longLabel).find("sensor label of"), std::string::npos) << check(longLabel);
 }

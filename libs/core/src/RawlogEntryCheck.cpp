@@ -75,127 +75,218 @@ std::uint64_t left(const RawlogEntryLimits& l, const Reader& r, std::size_t star
 	return l.bytesLeft > used ? l.bytesLeft - used : 0;
 }
 
-std::optional<std::string> checkRangeImage(Reader& r, const RawlogEntryLimits& l, std::size_t start);
-std::optional<std::string> checkImage(Reader& r, const char* which, const RawlogEntryLimits& l, std::size_t start);
+/** One step of the walk: nullopt stops it (a layout not walked, or a short read: the
+ * deserializer reports the rest), "" walked past the part, any other text is the damage. */
+using Step = std::optional<std::string>;
+const Step kWalked = std::string();
+#define KEYGRID_WALK(step)                        \
+	do                                            \
+	{                                             \
+		const Step s_ = (step);                   \
+		if (!s_ || !s_->empty()) return s_;       \
+	} while (false)
 
-// CObservation3DRangeScan (versions 9, 10) up to its images:
-//   float maxRange, CPose3D sensorPose (an object: header, 12 or 7 doubles, end byte 0x88),
-//   bool hasPoints3D [uint32 N, 3 x N float, 2 x N uint16], bool hasRangeImage,
-//   float rangeUnits [uint32 rows, uint32 cols, rows x cols uint16],
-//   bool hasIntensityImage [CImage], bool hasConfidenceImage [CImage], ... (not walked further).
+/** Walks a CObservation3DRangeScan in MRPT 2's serialization (versions 9 and 10):
+ *   float maxRange, CPose3D sensorPose, bool hasPoints3D [uint32 N, 3 x N float, 2 x N uint16],
+ *   bool hasRangeImage, float rangeUnits [uint32 rows, cols, rows x cols uint16],
+ *   bool hasIntensityImage [CImage], bool hasConfidenceImage [CImage], TCamera cameraParams,
+ *   TCamera cameraParamsIntensity, CPose3D relativePoseIntensityWRTDepth, float stdError,
+ *   uint64 timestamp, string sensorLabel, bool + string (external points file), bool + string
+ *   (external range file), bool rangeIsDepth, int8 intensityChannel, bool hasPixelLabels
+ *   [not walked], version 10: uint8 layers x {string name, uint32 rows, cols, rows x cols uint16}.
+ * Nested objects end with the byte 0x88; strings are a uint32 length and the characters. */
+class RangeScanWalker
+{
+   public:
+	RangeScanWalker(Reader& r, const RawlogEntryLimits& l, std::size_t start) : m_r(r), m_l(l), m_start(start) {}
+
+	Step walk(std::uint8_t version)
+	{
+		if (version < 9 || version > 10) return std::nullopt;
+		if (!m_r.value<float>()) return std::nullopt;
+		KEYGRID_WALK(pose());
+		const auto hasPoints = m_r.value<std::uint8_t>();
+		if (!hasPoints) return std::nullopt;
+		if (*hasPoints) KEYGRID_WALK(points());
+		const auto hasRange = m_r.value<std::uint8_t>();
+		if (!hasRange || !m_r.value<float>()) return std::nullopt;
+		if (*hasRange) KEYGRID_WALK(uint16Image("range image"));
+		for (const char* which : {"intensity", "confidence"})
+		{
+			const auto has = m_r.value<std::uint8_t>();
+			if (!has) return std::nullopt;
+			if (*has) KEYGRID_WALK(image(which));
+		}
+		KEYGRID_WALK(camera());
+		KEYGRID_WALK(camera());
+		KEYGRID_WALK(pose());
+		if (!m_r.value<float>() || !m_r.value<std::uint64_t>()) return std::nullopt;
+		KEYGRID_WALK(string("sensor label"));
+		for (const char* file : {"external 3D points file name", "external range image file name"})
+		{
+			if (!m_r.value<std::uint8_t>()) return std::nullopt;
+			KEYGRID_WALK(string(file));
+		}
+		if (!m_r.value<std::uint8_t>() || !m_r.value<std::int8_t>()) return std::nullopt;
+		const auto labels = m_r.value<std::uint8_t>();
+		if (!labels || *labels || version < 10) return std::nullopt;  // pixel labels: not walked
+		const auto layers = m_r.value<std::uint8_t>();
+		if (!layers) return std::nullopt;
+		for (int i = 0; i < *layers; i++)
+		{
+			KEYGRID_WALK(string("range image layer name"));
+			KEYGRID_WALK(uint16Image("range image layer"));
+		}
+		return kWalked;
+	}
+
+   private:
+	std::uint64_t left() const { return core::left(m_l, m_r, m_start); }
+	std::string tooLarge(const std::string& what, std::uint64_t bytes) const
+	{
+		return "CObservation3DRangeScan " + what + " needs " + std::to_string(bytes) + " bytes, more than the " + std::to_string(left()) +
+			   " bytes left in the file";
+	}
+	Step end()
+	{
+		const auto e = m_r.value<std::uint8_t>();
+		return e && *e == 0x88 ? kWalked : Step();
+	}
+	/** A nested CPose3D, read into an existing object: MRPT does not check the class name, so
+	 * neither does this walk. Version 3: translation + rotation matrix (12 doubles), 2:
+	 * translation + quaternion (7); older ones nest a matrix object (not walked). */
+	Step pose()
+	{
+		const auto h = m_r.header();
+		if (!h || (h->second != 2 && h->second != 3)) return std::nullopt;
+		if (!m_r.bytes((h->second == 3 ? 12 : 7) * sizeof(double))) return std::nullopt;
+		return end();
+	}
+	/** A nested TCamera (versions 4 to 6): 13 doubles (focal length, 8 distortion, fx fy cx cy),
+	 * uint32 nrows, ncols, [v5: string name], [v6: uint8 distortion model]. */
+	Step camera()
+	{
+		const auto h = m_r.header();
+		if (!h || h->second < 4 || h->second > 6) return std::nullopt;
+		if (!m_r.bytes(13 * sizeof(double) + 2 * sizeof(std::uint32_t))) return std::nullopt;
+		if (h->second >= 5) KEYGRID_WALK(string("camera name"));
+		if (h->second >= 6 && !m_r.value<std::uint8_t>()) return std::nullopt;
+		return end();
+	}
+	Step string(const char* what)
+	{
+		const auto n = m_r.value<std::uint32_t>();
+		if (!n) return std::nullopt;
+		if (*n > std::min<std::uint64_t>(left(), m_l.maxStringBytes))
+			return "CObservation3DRangeScan " + std::string(what) + " of " + std::to_string(*n) + " bytes does not fit in the file";
+		return m_r.bytes(*n) ? kWalked : Step();
+	}
+	Step points()
+	{
+		const auto n = m_r.value<std::uint32_t>();
+		if (!n) return std::nullopt;
+		if (*n > m_l.maxPoints)
+			return "CObservation3DRangeScan declares " + std::to_string(*n) + " 3D points (more than " + std::to_string(m_l.maxPoints) + ")";
+		const std::uint64_t bytes = std::uint64_t{*n} * (3 * sizeof(float) + 2 * sizeof(std::uint16_t));
+		if (bytes > left())
+			return "CObservation3DRangeScan declares " + std::to_string(*n) + " 3D points (" + std::to_string(bytes) +
+				   " bytes), more than the " + std::to_string(left()) + " bytes left in the file";
+		return m_r.bytes(static_cast<std::size_t>(bytes)) ? kWalked : Step();
+	}
+	/** uint32 rows, cols, then rows x cols uint16: the range image and its extra layers. */
+	Step uint16Image(const std::string& what)
+	{
+		const auto rows = m_r.value<std::uint32_t>();
+		const auto cols = rows ? m_r.value<std::uint32_t>() : std::nullopt;
+		if (!rows || !cols) return std::nullopt;
+		const std::string size = what + " of " + std::to_string(*cols) + " x " + std::to_string(*rows) + " pixels";
+		if (*rows > m_l.maxImageSide || *cols > m_l.maxImageSide)
+			return "CObservation3DRangeScan " + size + " (a side over " + std::to_string(m_l.maxImageSide) + ")";
+		const std::uint64_t pixels = std::uint64_t{*rows} * *cols, bytes = pixels * sizeof(std::uint16_t);
+		if (pixels > m_l.maxImagePixels)
+			return "CObservation3DRangeScan " + size + " (more than " + std::to_string(m_l.maxImagePixels) + ")";
+		if (bytes > left()) return tooLarge(size, bytes);
+		return m_r.bytes(static_cast<std::size_t>(bytes)) ? kWalked : Step();
+	}
+	/** A nested CImage (versions 7 to 9; MRPT 2.5 writes 9): bool external [string file name] |
+	 * bool colour; grey: int32 width, height, origin, imageSize, [v9: depth], bool zip, raw
+	 * bytes; colour: int32 width, height: both >= 1, a JPEG (uint32 n, n bytes); both < 0, raw
+	 * pixels (|width| x |height| x 3 bytes). MRPT hands the JPEG to libjpeg with its default
+	 * error handler, which ends the process (exit(), no exception) on a damaged stream: the JPEG
+	 * is decoded here first, by OpenCV, whose libjpeg error handler returns an error instead. */
+	Step image(const char* which)
+	{
+		const std::string what = std::string(which) + " image";
+		const auto h = m_r.header();
+		if (!h || h->second < 7 || h->second > 9) return std::nullopt;
+		const auto external = m_r.value<std::uint8_t>();
+		if (!external) return std::nullopt;
+		if (*external)
+		{
+			KEYGRID_WALK(string((what + " file name").c_str()));
+			return end();
+		}
+		const auto colour = m_r.value<std::uint8_t>();
+		if (!colour) return std::nullopt;
+		if (!*colour) KEYGRID_WALK(greyPixels(what, h->second));
+		else KEYGRID_WALK(colourPixels(what));
+		return end();
+	}
+	Step greyPixels(const std::string& what, std::uint8_t version)
+	{
+		if (!m_r.bytes(4 * sizeof(std::int32_t))) return std::nullopt;
+		std::uint32_t imageSize = 0;
+		std::memcpy(&imageSize, m_r.data() + m_r.count() - sizeof(std::int32_t), sizeof(imageSize));
+		if (version >= 9 && !m_r.value<std::int32_t>()) return std::nullopt;
+		const auto zip = m_r.value<std::uint8_t>();
+		if (!zip || *zip) return std::nullopt;  // MRPT refuses zip-compressed images itself
+		if (imageSize > left()) return tooLarge(what, imageSize);
+		return m_r.bytes(imageSize) ? kWalked : Step();
+	}
+	Step colourPixels(const std::string& what)
+	{
+		const auto w = m_r.value<std::int32_t>();
+		const auto h = w ? m_r.value<std::int32_t>() : std::nullopt;
+		if (!w || !h) return std::nullopt;
+		if (*w >= 1 && *h >= 1)
+		{
+			const auto n = m_r.value<std::uint32_t>();
+			if (!n) return std::nullopt;
+			if (*n > left()) return tooLarge(what + " (JPEG)", *n);
+			const std::size_t at = m_r.count();
+			if (!m_r.bytes(*n)) return std::nullopt;
+			bool decodes = false;
+			try
+			{
+				const cv::Mat jpeg(1, static_cast<int>(*n), CV_8UC1, const_cast<std::uint8_t*>(m_r.data() + at));
+				decodes = *n > 0 && !cv::imdecode(jpeg, cv::IMREAD_REDUCED_GRAYSCALE_8).empty();
+			}
+			catch (const cv::Exception&)
+			{
+			}
+			if (!decodes) return "CObservation3DRangeScan " + what + ": its " + std::to_string(*n) + " bytes of JPEG data do not decode";
+			return kWalked;
+		}
+		if (*w < 0 && *h < 0)
+		{
+			const std::uint64_t pixels = std::uint64_t(-std::int64_t{*w}) * std::uint64_t(-std::int64_t{*h});
+			const std::string size = what + " of " + std::to_string(-std::int64_t{*w}) + " x " + std::to_string(-std::int64_t{*h}) + " pixels";
+			if (pixels > m_l.maxImagePixels) return "CObservation3DRangeScan " + size + " (more than " + std::to_string(m_l.maxImagePixels) + ")";
+			if (3 * pixels > left()) return tooLarge(size, 3 * pixels);
+			return m_r.bytes(static_cast<std::size_t>(3 * pixels)) ? kWalked : Step();
+		}
+		return kWalked;  // an empty image: nothing follows
+	}
+
+	Reader& m_r;
+	const RawlogEntryLimits& m_l;
+	std::size_t m_start;
+};
+#undef KEYGRID_WALK
+
 std::string checkRangeScan(Reader& r, std::uint8_t version, const RawlogEntryLimits& l, std::size_t start)
 {
-	if (version < 9 || version > 10) return {};
-	if (!r.value<float>()) return {};
-	// The sensor pose is read into an existing CPose3D: MRPT does not check the class name, so
-	// neither does this walk. Version 3: translation + rotation matrix (12 doubles), 2:
-	// translation + quaternion (7); older ones nest a matrix object (not walked).
-	const auto pose = r.header();
-	if (!pose || (pose->second != 2 && pose->second != 3)) return {};
-	if (!r.bytes((pose->second == 3 ? 12 : 7) * sizeof(double))) return {};
-	const auto end = r.value<std::uint8_t>();
-	if (!end || *end != 0x88) return {};
-	const auto hasPoints = r.value<std::uint8_t>();
-	if (!hasPoints) return {};
-	if (*hasPoints)
-	{
-		const auto n = r.value<std::uint32_t>();
-		if (!n) return {};
-		const std::uint64_t bytes = std::uint64_t{*n} * (3 * sizeof(float) + 2 * sizeof(std::uint16_t));
-		if (*n > l.maxPoints)
-			return "CObservation3DRangeScan declares " + std::to_string(*n) + " 3D points (more than " + std::to_string(l.maxPoints) + ")";
-		if (bytes > left(l, r, start))
-			return "CObservation3DRangeScan declares " + std::to_string(*n) + " 3D points (" + std::to_string(bytes) +
-				   " bytes), more than the " + std::to_string(left(l, r, start)) + " bytes left in the file";
-		if (!r.bytes(static_cast<std::size_t>(bytes))) return {};
-	}
-	const auto hasRange = r.value<std::uint8_t>();
-	if (!hasRange || !r.value<float>()) return {};
-	if (*hasRange)
-	{
-		const auto why = checkRangeImage(r, l, start);
-		if (!why || !why->empty()) return why.value_or("");
-	}
-	// The intensity image, then the confidence image: walked while their layout is known.
-	for (const char* which : {"intensity", "confidence"})
-	{
-		const auto has = r.value<std::uint8_t>();
-		if (!has) return {};
-		if (!*has) continue;
-		const auto why = checkImage(r, which, l, start);
-		if (!why || !why->empty()) return why.value_or("");
-	}
-	return {};
-}
-
-/** The range image size and data: nullopt (stop walking), "" (walked past it) or the damage. */
-std::optional<std::string> checkRangeImage(Reader& r, const RawlogEntryLimits& l, std::size_t start)
-{
-	const auto rows = r.value<std::uint32_t>();
-	const auto cols = rows ? r.value<std::uint32_t>() : std::nullopt;
-	if (!rows || !cols) return std::nullopt;
-	const std::string size = std::to_string(*cols) + " x " + std::to_string(*rows);
-	if (*rows > l.maxImageSide || *cols > l.maxImageSide)
-		return "CObservation3DRangeScan range image of " + size + " pixels (a side over " + std::to_string(l.maxImageSide) + ")";
-	const std::uint64_t pixels = std::uint64_t{*rows} * *cols, bytes = pixels * sizeof(std::uint16_t);
-	if (pixels > l.maxImagePixels)
-		return "CObservation3DRangeScan range image of " + size + " pixels (more than " + std::to_string(l.maxImagePixels) + ")";
-	if (bytes > left(l, r, start))
-		return "CObservation3DRangeScan range image of " + size + " pixels needs " + std::to_string(bytes) +
-			   " bytes, more than the " + std::to_string(left(l, r, start)) + " bytes left in the file";
-	if (!r.bytes(static_cast<std::size_t>(bytes))) return std::nullopt;
-	return std::string();
-}
-
-// A CImage (versions 7 to 9; MRPT 2.5 writes 9): bool external [string file name] | bool colour,
-// then for colour int32 width, height: both >= 1, a JPEG (uint32 n, n bytes); both < 0, raw
-// pixels (|width| x |height| x 3 bytes). MRPT hands the JPEG to libjpeg with its default error
-// handler, which ends the process (exit(), no exception) on a damaged stream: the JPEG is
-// decoded here first, by OpenCV, whose libjpeg error handler returns an error instead.
-// Returns nullopt (stop walking), "" (walked past it) or the damage.
-std::optional<std::string> checkImage(Reader& r, const char* which, const RawlogEntryLimits& l, std::size_t start)
-{
-	const auto h = r.header();
-	if (!h || h->second < 7 || h->second > 9) return std::nullopt;
-	const auto external = r.value<std::uint8_t>();
-	if (!external || *external) return std::nullopt;  // a file name: read later, by OpenCV
-	const auto colour = r.value<std::uint8_t>();
-	if (!colour || !*colour) return std::nullopt;  // grey: not walked
-	const auto w = r.value<std::int32_t>();
-	const auto hgt = w ? r.value<std::int32_t>() : std::nullopt;
-	if (!w || !hgt) return std::nullopt;
-	if (*w >= 1 && *hgt >= 1)
-	{
-		const auto n = r.value<std::uint32_t>();
-		if (!n) return std::nullopt;
-		if (*n > left(l, r, start))
-			return std::string("CObservation3DRangeScan ") + which + " image declares a JPEG of " + std::to_string(*n) +
-				   " bytes, more than the " + std::to_string(left(l, r, start)) + " bytes left in the file";
-		const std::size_t at = r.count();
-		if (!r.bytes(*n)) return std::nullopt;
-		const cv::Mat jpeg(1, static_cast<int>(*n), CV_8UC1, const_cast<std::uint8_t*>(r.data() + at));
-		bool decodes = false;
-		try
-		{
-			decodes = *n > 0 && !cv::imdecode(jpeg, cv::IMREAD_REDUCED_GRAYSCALE_8).empty();
-		}
-		catch (const cv::Exception&)
-		{
-		}
-		if (!decodes)
-			return std::string("CObservation3DRangeScan ") + which + " image: its " + std::to_string(*n) + " bytes of JPEG data do not decode";
-		return std::string();
-	}
-	if (*w < 0 && *hgt < 0)
-	{
-		const std::uint64_t pixels = std::uint64_t(-std::int64_t{*w}) * std::uint64_t(-std::int64_t{*hgt});
-		if (pixels > l.maxImagePixels || 3 * pixels > left(l, r, start))
-			return std::string("CObservation3DRangeScan ") + which + " image of " + std::to_string(-std::int64_t{*w}) + " x " +
-				   std::to_string(-std::int64_t{*hgt}) + " pixels does not fit in the file";
-		if (!r.bytes(static_cast<std::size_t>(3 * pixels))) return std::nullopt;
-		return std::string();
-	}
-	return std::nullopt;
+	return RangeScanWalker(r, l, start).walk(version).value_or("");
 }
 }  // namespace
 

@@ -12,9 +12,10 @@
  * A colour image stored as JPEG inside the entry is decoded first too: MRPT hands it to
  * libjpeg with the default error handler, which ends the process (exit()) on a damaged stream.
  *
- * Walked: a CObservation3DRangeScan (serialization versions 9 and 10, MRPT 2.x), at the top
- * level or as the first observation of a CSensoryFrame, up to its intensity and confidence
- * images. Any other object, or a layout this walker does not know, is passed on unchecked.
+ * Walked: a CObservation3DRangeScan (serialization versions 9 and 10, MRPT 2.x) to its end (its
+ * range image and extra layers, images, cameras, strings), at the top level or as the first
+ * observation of a CSensoryFrame. Any other object, or a layout this walker does not know (pixel
+ * labels, old pose or image versions), ends the walk there: the rest is passed on unchecked.
  */
 #include <mrpt/io/CStream.h>
 
@@ -37,6 +38,8 @@ struct RawlogEntryLimits
 	 * MRPT allocate where bytesLeft is only a loose bound (gzip). */
 	std::uint64_t maxImagePixels{std::uint64_t{1} << 26};
 	std::uint64_t maxPoints{std::uint64_t{1} << 26};
+	/** Longest string (sensor label, file names): 1 MiB. */
+	std::uint64_t maxStringBytes{std::uint64_t{1} << 20};
 };
 
 /** Reads the head of the next serialized object from `in`, appending every byte read to
