@@ -208,27 +208,38 @@ class RangeScanWalker
 		if (bytes > left()) return tooLarge(size, bytes);
 		return m_r.bytes(static_cast<std::size_t>(bytes)) ? kWalked : Step();
 	}
-	/** A nested CImage (versions 7 to 9; MRPT 2.5 writes 9): bool external [string file name] |
-	 * bool colour; grey: int32 width, height, origin, imageSize, [v9: depth], bool zip, raw
-	 * bytes; colour: int32 width, height: both >= 1, a JPEG (uint32 n, n bytes); both < 0, raw
-	 * pixels (|width| x |height| x 3 bytes). MRPT hands the JPEG to libjpeg with its default
-	 * error handler, which ends the process (exit(), no exception) on a damaged stream: the JPEG
-	 * is decoded here first, by OpenCV, whose libjpeg error handler returns an error instead. */
+	/** A nested CImage (MRPT 2.5 writes version 9). Versions 2 to 9: [v6: bool external [string
+	 * file name]], bool colour; grey: int32 width, height, origin, imageSize, [v9: int32 depth],
+	 * [v5: bool zip], raw bytes; colour, from v7: int32 width, height: both >= 1, a JPEG; both
+	 * < 0, raw pixels (|width| x |height| x 3 bytes); colour before v7, and version 1: a JPEG
+	 * (uint32 n, n bytes). MRPT hands a JPEG to libjpeg with its default error handler, which
+	 * ends the process (exit(), no exception) on a damaged stream: it is decoded here first, by
+	 * OpenCV, whose libjpeg error handler returns an error instead. */
 	Step image(const char* which)
 	{
 		const std::string what = std::string(which) + " image";
 		const auto h = m_r.header();
-		if (!h || h->second < 7 || h->second > 9) return std::nullopt;
-		const auto external = m_r.value<std::uint8_t>();
-		if (!external) return std::nullopt;
-		if (*external)
+		if (!h || h->second == 0 || h->second > 9) return std::nullopt;  // v0: raw pixels, no JPEG
+		const std::uint8_t v = h->second;
+		if (v == 1)
 		{
-			KEYGRID_WALK(string((what + " file name").c_str()));
+			KEYGRID_WALK(jpeg(what));
 			return end();
+		}
+		if (v >= 6)
+		{
+			const auto external = m_r.value<std::uint8_t>();
+			if (!external) return std::nullopt;
+			if (*external)
+			{
+				KEYGRID_WALK(string((what + " file name").c_str()));
+				return end();
+			}
 		}
 		const auto colour = m_r.value<std::uint8_t>();
 		if (!colour) return std::nullopt;
-		if (!*colour) KEYGRID_WALK(greyPixels(what, h->second));
+		if (!*colour) KEYGRID_WALK(greyPixels(what, v));
+		else if (v < 7) KEYGRID_WALK(jpeg(what));
 		else KEYGRID_WALK(colourPixels(what));
 		return end();
 	}
@@ -238,35 +249,42 @@ class RangeScanWalker
 		std::uint32_t imageSize = 0;
 		std::memcpy(&imageSize, m_r.data() + m_r.count() - sizeof(std::int32_t), sizeof(imageSize));
 		if (version >= 9 && !m_r.value<std::int32_t>()) return std::nullopt;
-		const auto zip = m_r.value<std::uint8_t>();
-		if (!zip || *zip) return std::nullopt;  // MRPT refuses zip-compressed images itself
+		bool zip = version == 3 || (version == 4 && imageSize > 16 * 1024);
+		if (version >= 5)
+		{
+			const auto z = m_r.value<std::uint8_t>();
+			if (!z) return std::nullopt;
+			zip = *z != 0;
+		}
+		if (zip) return std::nullopt;  // MRPT refuses zip-compressed images itself
 		if (imageSize > left()) return tooLarge(what, imageSize);
 		return m_r.bytes(imageSize) ? kWalked : Step();
+	}
+	Step jpeg(const std::string& what)
+	{
+		const auto n = m_r.value<std::uint32_t>();
+		if (!n) return std::nullopt;
+		if (*n > left()) return tooLarge(what + " (JPEG)", *n);
+		const std::size_t at = m_r.count();
+		if (!m_r.bytes(*n)) return std::nullopt;
+		bool decodes = false;
+		try
+		{
+			const cv::Mat data(1, static_cast<int>(*n), CV_8UC1, const_cast<std::uint8_t*>(m_r.data() + at));
+			decodes = *n > 0 && !cv::imdecode(data, cv::IMREAD_REDUCED_GRAYSCALE_8).empty();
+		}
+		catch (const cv::Exception&)
+		{
+		}
+		if (!decodes) return "CObservation3DRangeScan " + what + ": its " + std::to_string(*n) + " bytes of JPEG data do not decode";
+		return kWalked;
 	}
 	Step colourPixels(const std::string& what)
 	{
 		const auto w = m_r.value<std::int32_t>();
 		const auto h = w ? m_r.value<std::int32_t>() : std::nullopt;
 		if (!w || !h) return std::nullopt;
-		if (*w >= 1 && *h >= 1)
-		{
-			const auto n = m_r.value<std::uint32_t>();
-			if (!n) return std::nullopt;
-			if (*n > left()) return tooLarge(what + " (JPEG)", *n);
-			const std::size_t at = m_r.count();
-			if (!m_r.bytes(*n)) return std::nullopt;
-			bool decodes = false;
-			try
-			{
-				const cv::Mat jpeg(1, static_cast<int>(*n), CV_8UC1, const_cast<std::uint8_t*>(m_r.data() + at));
-				decodes = *n > 0 && !cv::imdecode(jpeg, cv::IMREAD_REDUCED_GRAYSCALE_8).empty();
-			}
-			catch (const cv::Exception&)
-			{
-			}
-			if (!decodes) return "CObservation3DRangeScan " + what + ": its " + std::to_string(*n) + " bytes of JPEG data do not decode";
-			return kWalked;
-		}
+		if (*w >= 1 && *h >= 1) return jpeg(what);
 		if (*w < 0 && *h < 0)
 		{
 			const std::uint64_t pixels = std::uint64_t(-std::int64_t{*w}) * std::uint64_t(-std::int64_t{*h});
