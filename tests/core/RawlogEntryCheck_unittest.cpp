@@ -242,3 +242,12 @@ TEST(RawlogEntryCheck, TheTailOfTheEntryIsWalkedToo)
 	longLabel[static_cast<std::size_t>(at - bytes.begin()) - 1] = 0xff;  // the length's high byte
 	EXPECT_NE(check(longLabel).find("sensor label of"), std::string::npos) << check(longLabel);
 }
+
+TEST(RawlogEntryCheck, FlagsMustBeBooleans)
+{
+	// MRPT reads a flag byte into a bool unchecked: 20 would be undefined behaviour downstream
+	// (found by fuzz_rawlog).
+	auto bytes = serialize(*observation(0));
+	bytes[rowsColsOffset(bytes) - 5] = 20;  // hasRangeImage, before the float rangeUnits
+	EXPECT_EQ(check(bytes), "CObservation3DRangeScan hasRangeImage is 20, not a boolean (0 or 1)");
+}

@@ -105,31 +105,29 @@ class RangeScanWalker
 		if (version < 9 || version > 10) return std::nullopt;
 		if (!m_r.value<float>()) return std::nullopt;
 		KEYGRID_WALK(pose());
-		const auto hasPoints = m_r.value<std::uint8_t>();
-		if (!hasPoints) return std::nullopt;
-		if (*hasPoints) KEYGRID_WALK(points());
-		const auto hasRange = m_r.value<std::uint8_t>();
-		if (!hasRange || !m_r.value<float>()) return std::nullopt;
-		if (*hasRange) KEYGRID_WALK(uint16Image("range image"));
-		for (const char* which : {"intensity", "confidence"})
-		{
-			const auto has = m_r.value<std::uint8_t>();
-			if (!has) return std::nullopt;
-			if (*has) KEYGRID_WALK(image(which));
-		}
+		bool has = false;
+		KEYGRID_WALK(flag("hasPoints3D", has));
+		if (has) KEYGRID_WALK(points());
+		KEYGRID_WALK(flag("hasRangeImage", has));
+		if (!m_r.value<float>()) return std::nullopt;
+		if (has) KEYGRID_WALK(uint16Image("range image"));
+		KEYGRID_WALK(flag("hasIntensityImage", has));
+		if (has) KEYGRID_WALK(image("intensity"));
+		KEYGRID_WALK(flag("hasConfidenceImage", has));
+		if (has) KEYGRID_WALK(image("confidence"));
 		KEYGRID_WALK(camera());
 		KEYGRID_WALK(camera());
 		KEYGRID_WALK(pose());
 		if (!m_r.value<float>() || !m_r.value<std::uint64_t>()) return std::nullopt;
 		KEYGRID_WALK(string("sensor label"));
-		for (const char* file : {"external 3D points file name", "external range image file name"})
-		{
-			if (!m_r.value<std::uint8_t>()) return std::nullopt;
-			KEYGRID_WALK(string(file));
-		}
-		if (!m_r.value<std::uint8_t>() || !m_r.value<std::int8_t>()) return std::nullopt;
-		const auto labels = m_r.value<std::uint8_t>();
-		if (!labels || *labels || version < 10) return std::nullopt;  // pixel labels: not walked
+		KEYGRID_WALK(flag("points3D external", has));
+		KEYGRID_WALK(string("external 3D points file name"));
+		KEYGRID_WALK(flag("rangeImage external", has));
+		KEYGRID_WALK(string("external range image file name"));
+		KEYGRID_WALK(flag("range_is_depth", has));
+		if (!m_r.value<std::int8_t>()) return std::nullopt;
+		KEYGRID_WALK(flag("has pixel labels", has));
+		if (has || version < 10) return std::nullopt;  // pixel labels: not walked
 		const auto layers = m_r.value<std::uint8_t>();
 		if (!layers) return std::nullopt;
 		for (int i = 0; i < *layers; i++)
@@ -146,6 +144,16 @@ class RangeScanWalker
 	{
 		return "CObservation3DRangeScan " + what + " needs " + std::to_string(bytes) + " bytes, more than the " + std::to_string(left()) +
 			   " bytes left in the file";
+	}
+	/** A bool as MRPT writes it, one byte: 0 or 1. MRPT reads any other value into a bool
+	 * unchecked (undefined behaviour when it is used). */
+	Step flag(const char* what, bool& out)
+	{
+		const auto b = m_r.value<std::uint8_t>();
+		if (!b) return std::nullopt;
+		if (*b > 1) return "CObservation3DRangeScan " + std::string(what) + " is " + std::to_string(*b) + ", not a boolean (0 or 1)";
+		out = *b == 1;
+		return kWalked;
 	}
 	Step end()
 	{
@@ -226,19 +234,18 @@ class RangeScanWalker
 			KEYGRID_WALK(jpeg(what));
 			return end();
 		}
+		bool yes = false;
 		if (v >= 6)
 		{
-			const auto external = m_r.value<std::uint8_t>();
-			if (!external) return std::nullopt;
-			if (*external)
+			KEYGRID_WALK(flag((what + " external").c_str(), yes));
+			if (yes)
 			{
 				KEYGRID_WALK(string((what + " file name").c_str()));
 				return end();
 			}
 		}
-		const auto colour = m_r.value<std::uint8_t>();
-		if (!colour) return std::nullopt;
-		if (!*colour) KEYGRID_WALK(greyPixels(what, v));
+		KEYGRID_WALK(flag((what + " colour").c_str(), yes));
+		if (!yes) KEYGRID_WALK(greyPixels(what, v));
 		else if (v < 7) KEYGRID_WALK(jpeg(what));
 		else KEYGRID_WALK(colourPixels(what));
 		return end();
@@ -250,12 +257,7 @@ class RangeScanWalker
 		std::memcpy(&imageSize, m_r.data() + m_r.count() - sizeof(std::int32_t), sizeof(imageSize));
 		if (version >= 9 && !m_r.value<std::int32_t>()) return std::nullopt;
 		bool zip = version == 3 || (version == 4 && imageSize > 16 * 1024);
-		if (version >= 5)
-		{
-			const auto z = m_r.value<std::uint8_t>();
-			if (!z) return std::nullopt;
-			zip = *z != 0;
-		}
+		if (version >= 5) KEYGRID_WALK(flag((what + " zip").c_str(), zip));
 		if (zip) return std::nullopt;  // MRPT refuses zip-compressed images itself
 		if (imageSize > left()) return tooLarge(what, imageSize);
 		return m_r.bytes(imageSize) ? kWalked : Step();
