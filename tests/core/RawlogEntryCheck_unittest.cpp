@@ -251,3 +251,20 @@ TEST(RawlogEntryCheck, FlagsMustBeBooleans)
 	bytes[rowsColsOffset(bytes) - 5] = 20;  // hasRangeImage, before the float rangeUnits
 	EXPECT_EQ(check(bytes), "CObservation3DRangeScan hasRangeImage is 20, not a boolean (0 or 1)");
 }
+
+TEST(RawlogEntryCheck, AnImageEntryOfItsOwnHasItsJpegDecodedToo)
+{
+	// A rawlog entry that is a CImage (skipped by the frame source, but MRPT decodes it first).
+	mrpt::img::CImage img(40, 30, mrpt::img::CH_RGB);
+	img.filledRectangle(0, 0, 39, 29, mrpt::img::TColor(200, 100, 50));
+	const bool before = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+	auto bytes = serialize(img);
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(before);
+	EXPECT_EQ(check(bytes), "");
+	const std::uint8_t soi[2] = {0xFF, 0xD8};
+	const auto at = std::search(bytes.begin(), bytes.end(), soi, soi + 2);
+	ASSERT_NE(at, bytes.end());
+	*at = 0x58;
+	EXPECT_NE(check(bytes).find("CImage entry: its "), std::string::npos) << check(bytes);
+}

@@ -95,10 +95,14 @@ const Step kWalked = std::string();
  *   (external range file), bool rangeIsDepth, int8 intensityChannel, bool hasPixelLabels
  *   [not walked], version 10: uint8 layers x {string name, uint32 rows, cols, rows x cols uint16}.
  * Nested objects end with the byte 0x88; strings are a uint32 length and the characters. */
-class RangeScanWalker
+class EntryWalker
 {
    public:
-	RangeScanWalker(Reader& r, const RawlogEntryLimits& l, std::size_t start) : m_r(r), m_l(l), m_start(start) {}
+	/** `subject`: the class named in errors. */
+	EntryWalker(Reader& r, const RawlogEntryLimits& l, std::size_t start, std::string subject = "CObservation3DRangeScan")
+		: m_r(r), m_l(l), m_start(start), m_subject(std::move(subject))
+	{
+	}
 
 	Step walk(std::uint8_t version)
 	{
@@ -142,7 +146,7 @@ class RangeScanWalker
 	std::uint64_t left() const { return core::left(m_l, m_r, m_start); }
 	std::string tooLarge(const std::string& what, std::uint64_t bytes) const
 	{
-		return "CObservation3DRangeScan " + what + " needs " + std::to_string(bytes) + " bytes, more than the " + std::to_string(left()) +
+		return m_subject + " " + what + " needs " + std::to_string(bytes) + " bytes, more than the " + std::to_string(left()) +
 			   " bytes left in the file";
 	}
 	/** A bool as MRPT writes it, one byte: 0 or 1. MRPT reads any other value into a bool
@@ -151,7 +155,7 @@ class RangeScanWalker
 	{
 		const auto b = m_r.value<std::uint8_t>();
 		if (!b) return std::nullopt;
-		if (*b > 1) return "CObservation3DRangeScan " + std::string(what) + " is " + std::to_string(*b) + ", not a boolean (0 or 1)";
+		if (*b > 1) return m_subject + " " + std::string(what) + " is " + std::to_string(*b) + ", not a boolean (0 or 1)";
 		out = *b == 1;
 		return kWalked;
 	}
@@ -186,7 +190,7 @@ class RangeScanWalker
 		const auto n = m_r.value<std::uint32_t>();
 		if (!n) return std::nullopt;
 		if (*n > std::min<std::uint64_t>(left(), m_l.maxStringBytes))
-			return "CObservation3DRangeScan " + std::string(what) + " of " + std::to_string(*n) + " bytes does not fit in the file";
+			return m_subject + " " + std::string(what) + " of " + std::to_string(*n) + " bytes does not fit in the file";
 		return m_r.bytes(*n) ? kWalked : Step();
 	}
 	Step points()
@@ -209,10 +213,10 @@ class RangeScanWalker
 		if (!rows || !cols) return std::nullopt;
 		const std::string size = what + " of " + std::to_string(*cols) + " x " + std::to_string(*rows) + " pixels";
 		if (*rows > m_l.maxImageSide || *cols > m_l.maxImageSide)
-			return "CObservation3DRangeScan " + size + " (a side over " + std::to_string(m_l.maxImageSide) + ")";
+			return m_subject + " " + size + " (a side over " + std::to_string(m_l.maxImageSide) + ")";
 		const std::uint64_t pixels = std::uint64_t{*rows} * *cols, bytes = pixels * sizeof(std::uint16_t);
 		if (pixels > m_l.maxImagePixels)
-			return "CObservation3DRangeScan " + size + " (more than " + std::to_string(m_l.maxImagePixels) + ")";
+			return m_subject + " " + size + " (more than " + std::to_string(m_l.maxImagePixels) + ")";
 		if (bytes > left()) return tooLarge(size, bytes);
 		return m_r.bytes(static_cast<std::size_t>(bytes)) ? kWalked : Step();
 	}
@@ -225,10 +229,16 @@ class RangeScanWalker
 	 * OpenCV, whose libjpeg error handler returns an error instead. */
 	Step image(const char* which)
 	{
-		const std::string what = std::string(which) + " image";
 		const auto h = m_r.header();
-		if (!h || h->second == 0 || h->second > 9) return std::nullopt;  // v0: raw pixels, no JPEG
-		const std::uint8_t v = h->second;
+		if (!h) return std::nullopt;
+		return imageBody(h->second, std::string(which) + " image");
+	}
+
+   public:
+	/** A CImage after its header (version `v`), up to and with its end byte. */
+	Step imageBody(std::uint8_t v, const std::string& what)
+	{
+		if (v == 0 || v > 9) return std::nullopt;  // v0: raw pixels, no JPEG
 		if (v == 1)
 		{
 			KEYGRID_WALK(jpeg(what));
@@ -250,6 +260,7 @@ class RangeScanWalker
 		else KEYGRID_WALK(colourPixels(what));
 		return end();
 	}
+   private:
 	Step greyPixels(const std::string& what, std::uint8_t version)
 	{
 		if (!m_r.bytes(4 * sizeof(std::int32_t))) return std::nullopt;
@@ -278,7 +289,7 @@ class RangeScanWalker
 		catch (const cv::Exception&)
 		{
 		}
-		if (!decodes) return "CObservation3DRangeScan " + what + ": its " + std::to_string(*n) + " bytes of JPEG data do not decode";
+		if (!decodes) return m_subject + " " + what + ": its " + std::to_string(*n) + " bytes of JPEG data do not decode";
 		return kWalked;
 	}
 	Step colourPixels(const std::string& what)
@@ -291,7 +302,7 @@ class RangeScanWalker
 		{
 			const std::uint64_t pixels = std::uint64_t(-std::int64_t{*w}) * std::uint64_t(-std::int64_t{*h});
 			const std::string size = what + " of " + std::to_string(-std::int64_t{*w}) + " x " + std::to_string(-std::int64_t{*h}) + " pixels";
-			if (pixels > m_l.maxImagePixels) return "CObservation3DRangeScan " + size + " (more than " + std::to_string(m_l.maxImagePixels) + ")";
+			if (pixels > m_l.maxImagePixels) return m_subject + " " + size + " (more than " + std::to_string(m_l.maxImagePixels) + ")";
 			if (3 * pixels > left()) return tooLarge(size, 3 * pixels);
 			return m_r.bytes(static_cast<std::size_t>(3 * pixels)) ? kWalked : Step();
 		}
@@ -301,12 +312,13 @@ class RangeScanWalker
 	Reader& m_r;
 	const RawlogEntryLimits& m_l;
 	std::size_t m_start;
+	std::string m_subject;
 };
 #undef KEYGRID_WALK
 
 std::string checkRangeScan(Reader& r, std::uint8_t version, const RawlogEntryLimits& l, std::size_t start)
 {
-	return RangeScanWalker(r, l, start).walk(version).value_or("");
+	return EntryWalker(r, l, start).walk(version).value_or("");
 }
 }  // namespace
 
@@ -317,6 +329,8 @@ std::string checkRawlogEntry(mrpt::io::CStream& in, std::vector<std::uint8_t>& c
 	const auto h = r.header();
 	if (!h) return {};
 	if (isClass(h->first, "CObservation3DRangeScan")) return checkRangeScan(r, h->second, limits, start);
+	// An image on its own (not an observation, skipped later): its JPEG is decoded all the same.
+	if (isClass(h->first, "CImage")) return EntryWalker(r, limits, start, "CImage").imageBody(h->second, "entry").value_or("");
 	// CSensoryFrame (version 2): uint32 count, then the observations as objects.
 	if (isClass(h->first, "CSensoryFrame") && h->second == 2)
 	{
