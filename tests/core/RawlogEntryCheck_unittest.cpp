@@ -128,16 +128,20 @@ TEST(RawlogEntryCheck, DamagedSizesAreNamed)
 	EXPECT_NE(check(sfBytes).find("a side over 32768"), std::string::npos);
 }
 
-TEST(RawlogEntryCheck, ATruncatedEntryIsLeftToTheDeserializer)
+TEST(RawlogEntryCheck, ATruncatedEntryIsNamed)
 {
+	// The file ending inside an entry is said by the check (MRPT, reading on, could take what
+	// follows a damaged gzip stream for the rest of the entry); every byte read is kept.
 	const auto bytes = serialize(*observation(0));
-	for (const std::size_t cut : {std::size_t{0}, std::size_t{1}, std::size_t{20}, std::size_t{100}, rowsColsOffset(bytes) + 6})
+	for (const std::size_t cut : {std::size_t{1}, std::size_t{20}, std::size_t{100}, rowsColsOffset(bytes) + 6, bytes.size() - 2})
 	{
 		const std::vector<std::uint8_t> part(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(cut));
 		std::vector<std::uint8_t> consumed;
-		EXPECT_EQ(check(part, &consumed), "") << cut;
+		EXPECT_EQ(check(part, &consumed), "the file ends inside it (" + std::to_string(cut) + " bytes read)") << cut;
 		EXPECT_EQ(consumed, part) << "every byte read is kept for the replay, cut " << cut;
 	}
+	// Nothing left at all: the end of the file, not a damage.
+	EXPECT_EQ(check({}), "");
 }
 
 TEST(RawlogEntryCheck, ADamagedCountClaimsNoMoreMemoryThanTheDataThere)
@@ -157,13 +161,13 @@ TEST(RawlogEntryCheck, ADamagedCountClaimsNoMoreMemoryThanTheDataThere)
 		std::vector<std::uint8_t> head;
 		EXPECT_EQ(checkRawlogEntry(in, head, RawlogEntryLimits{}), "CObservation3DRangeScan declares 1073741874 3D points (more than 67108864)");
 	}
-	// Without the bound: the check reads what is there and stops.
+	// Without the bound: the check reads what is there, and finds the data end inside the entry.
 	mrpt::io::CMemoryStream in;
 	in.assignMemoryNotOwn(bytes.data(), bytes.size());
 	std::vector<std::uint8_t> head;
 	RawlogEntryLimits unbounded;
 	unbounded.maxPoints = UINT64_MAX;
-	EXPECT_EQ(checkRawlogEntry(in, head, unbounded), "");
+	EXPECT_EQ(checkRawlogEntry(in, head, unbounded), "the file ends inside it (" + std::to_string(bytes.size()) + " bytes read)");
 	EXPECT_EQ(head.size(), bytes.size());
 	EXPECT_LE(head.capacity(), 2 * bytes.size() + (std::size_t{1} << 21));
 }

@@ -27,6 +27,8 @@
 #include <mrpt/system/filesystem.h>
 
 #include "SimSlamRun.h"
+#include <nlohmann/json.hpp>
+
 #include "TestData.h"
 
 #include <algorithm>
@@ -232,17 +234,16 @@ void checkScene(const std::string& out)
 	// One "map_<i>_<class>" set per map of the run (report.json lists them); the 3D grid's
 	// occupied voxels are those of map_3d.ply.
 	const std::string report = test::readTextFile(out + "/report.json");
+	const auto reportMaps = nlohmann::json::parse(report)["maps"];
 	std::map<std::string, mrpt::opengl::CSetOfObjects::Ptr> mapSets;  // class -> set
 	for (const auto& o : *scene.getViewport())
 		if (o->getName().rfind("map_", 0) == 0)
 		{
 			const std::string cls = o->getName().substr(o->getName().find('_', 4) + 1);
-			EXPECT_NE(report.find("{\"class\": \"" + cls + "\""), std::string::npos) << cls;
+			EXPECT_TRUE(std::any_of(reportMaps.begin(), reportMaps.end(), [&](const auto& m) { return m["class"] == cls; })) << cls;
 			mapSets[cls] = std::dynamic_pointer_cast<mrpt::opengl::CSetOfObjects>(o);
 		}
-	std::size_t mapsInReport = 0;
-	for (auto pos = report.find("{\"class\": "); pos != std::string::npos; pos = report.find("{\"class\": ", pos + 1)) mapsInReport++;
-	EXPECT_EQ(mapSets.size(), mapsInReport);
+	EXPECT_EQ(mapSets.size(), reportMaps.size());
 	auto grid2d = mapSets["keygrid::CISMOccupancyGrid2D"];
 	auto grid3d = mapSets["keygrid::CSubmappedOccupancyGrid3D"];
 	ASSERT_TRUE(grid2d);
@@ -350,7 +351,7 @@ TEST(Outputs, MapOutputsShareTheEstimatedFloorFrame)
 	const std::string out = runSlamOnShortSimSequence();
 	ASSERT_FALSE(out.empty());
 	const std::string report = test::readTextFile(out + "/report.json");
-	EXPECT_NE(report.find("\"floor\": {\"source\": \"estimated\""), std::string::npos);
+	EXPECT_EQ(nlohmann::json::parse(report)["floor"]["source"], "estimated");
 	const auto T_world_floor = reportFloorPose(report);
 	ASSERT_TRUE(T_world_floor);
 	const auto gt = core::readTumTrajectory(mrpt::system::extractFileDirectory(out) + "/seq/groundtruth.txt");

@@ -26,8 +26,12 @@ class Reader
 			const std::size_t want = std::min(left, kPiece), at = m_consumed.size();
 			m_consumed.resize(at + want);
 			const std::size_t got = m_in.Read(m_consumed.data() + at, want);
-			m_consumed.resize(at + got);
-			if (got != want) return false;
+			m_consumed.resize(at + std::min(got, want));
+			if (got != want)
+			{
+				m_ended = true;
+				return false;
+			}
 			left -= got;
 		}
 		return true;
@@ -53,11 +57,14 @@ class Reader
 		return std::make_pair(name, *version);
 	}
 	std::size_t count() const { return m_consumed.size(); }
+	/** Whether a read came back short: the stream ends (or its data is damaged) there. */
+	bool ended() const { return m_ended; }
 	const std::uint8_t* data() const { return m_consumed.data(); }
 
    private:
 	mrpt::io::CStream& m_in;
 	std::vector<std::uint8_t>& m_consumed;
+	bool m_ended{false};
 };
 
 /** Whether a serialized class name names `cls`: MRPT looks classes up by the part after the
@@ -320,12 +327,8 @@ std::string checkRangeScan(Reader& r, std::uint8_t version, const RawlogEntryLim
 {
 	return EntryWalker(r, l, start).walk(version).value_or("");
 }
-}  // namespace
-
-std::string checkRawlogEntry(mrpt::io::CStream& in, std::vector<std::uint8_t>& consumed, const RawlogEntryLimits& limits)
+std::string checkEntry(Reader& r, const RawlogEntryLimits& limits, std::size_t start)
 {
-	Reader r(in, consumed);
-	const std::size_t start = r.count();
 	const auto h = r.header();
 	if (!h) return {};
 	if (isClass(h->first, "CObservation3DRangeScan")) return checkRangeScan(r, h->second, limits, start);
@@ -344,6 +347,18 @@ std::string checkRawlogEntry(mrpt::io::CStream& in, std::vector<std::uint8_t>& c
 			return checkRangeScan(r, first->second, limits, start);
 	}
 	return {};
+}
+}  // namespace
+
+std::string checkRawlogEntry(mrpt::io::CStream& in, std::vector<std::uint8_t>& consumed, const RawlogEntryLimits& limits)
+{
+	Reader r(in, consumed);
+	const std::size_t start = r.count();
+	std::string why = checkEntry(r, limits, start);
+	// The data ended inside an entry the walk was reading: it is truncated (or its gzip stream
+	// damaged). Said here rather than left to MRPT, which may read what follows differently.
+	if (why.empty() && r.ended() && r.count() > start) why = "the file ends inside it (" + std::to_string(r.count() - start) + " bytes read)";
+	return why;
 }
 
 size_t PrefixedStream::Read(void* buf, size_t n)

@@ -120,7 +120,7 @@ bool RawlogFrameSource::next(Frame& out)
 		{
 			m_impl->eof = true;
 			throw std::runtime_error(
-				"rawlog '" + m_path + "' is corrupt at entry " + std::to_string(m_impl->entry) + " (byte " +
+				"rawlog '" + m_path + "' is corrupt or truncated at entry " + std::to_string(m_impl->entry) + " (byte " +
 				std::to_string(posBefore) + "): " + damaged);
 		}
 		try

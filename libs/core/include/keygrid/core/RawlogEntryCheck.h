@@ -14,8 +14,9 @@
  *
  * Walked: a CObservation3DRangeScan (serialization versions 9 and 10, MRPT 2.x) to its end (its
  * range image and extra layers, images, cameras, strings), at the top level or as the first
- * observation of a CSensoryFrame. Any other object, or a layout this walker does not know (pixel
- * labels, old pose or image versions), ends the walk there: the rest is passed on unchecked.
+ * observation of a CSensoryFrame, and a CImage entry of its own. Any other object (other
+ * observation classes, whose images are not decoded first), or a layout this walker does not
+ * know (pixel labels, old pose versions), ends the walk there: the rest is passed on unchecked.
  */
 #include <mrpt/io/CStream.h>
 
