@@ -49,17 +49,26 @@ for t in $targets; do
   [ -d "$here/corpus/$t" ] && cp -r "$here/corpus/$t/." "$work/corpus/"
   log="$work/fuzz.log"
   t0=$(date +%s)
-  if (cd "$work" && "$build/fuzz_$t" -max_total_time="$seconds" -fork=1 -ignore_ooms=1 -ignore_timeouts=0 -ignore_crashes=0 -timeout=20 -rss_limit_mb=2560 -seed=1 \
-        -max_len=1048576 -artifact_prefix="$artifacts/" -print_final_stats=1 corpus >"$log" 2>&1); then
-    result=ok
-  else
+  # A guard against a run that does not end: SIGINT 60 s after the time (libFuzzer then exits
+  # as at the end of the time), SIGKILL 20 s after that.
+  (cd "$work" && timeout -s INT -k 20 "$((seconds + 60))" "$build/fuzz_$t" -max_total_time="$seconds" -fork=1 -ignore_ooms=1 -ignore_timeouts=0 -ignore_crashes=0 -timeout=20 -rss_limit_mb=2560 -seed=1 \
+        -max_len=1048576 -artifact_prefix="$artifacts/" -print_final_stats=1 corpus >"$log" 2>&1) || true
+  # Fork mode: the parent's progress lines "#N: cov: C ft: F ... exec/s S oom/timeout/crash: O/T/X".
+  # The parent exits non-zero after OOM inputs too, so the verdict is read from the log: any
+  # crash, timeout or leak input written, or counted, fails the target.
+  last=$(grep -E '^#[0-9]+: cov:' "$log" | tail -1 || true)
+  runs=$(echo "$last" | grep -oE '^#[0-9]+' | tr -d '#' || true)
+  cov=$(echo "$last" | grep -oE 'cov: [0-9]+ ft: [0-9]+' || true)
+  triple=$(echo "$last" | grep -oE 'oom/timeout/crash: [0-9]+/[0-9]+/[0-9]+' | grep -oE '[0-9]+/[0-9]+/[0-9]+' || echo "0/0/0")
+  ooms=${triple%%/*}; rest=${triple#*/}; timeouts=${rest%%/*}; crashes=${rest#*/}
+  if grep -qE 'Test unit written to .*/(crash|timeout|leak)-' "$log" || [ "${timeouts:-0}" != 0 ] || [ "${crashes:-0}" != 0 ] || [ -z "$last" ]; then
     result=FAILED; status=1
+  else
+    result=ok
   fi
-  runs=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
-  speed=$(grep -o 'stat::average_exec_per_sec: *[0-9]*' "$log" | grep -o '[0-9]*$' || echo "?")
-  cov=$(grep -oE 'cov: [0-9]+ ft: [0-9]+' "$log" | tail -1 || true)
-  ooms=$(grep -oE 'oom/timeout/crash: [0-9]+' "$log" | tail -1 | grep -oE '[0-9]+$' || echo 0)
-  printf 'fuzz_%-7s %-6s %10s execs  %7s exec/s  %s  oom inputs %s  (%s s)\n' "$t" "$result" "$runs" "$speed" "$cov" "${ooms:-0}" "$(( $(date +%s) - t0 ))"
+  elapsed=$(( $(date +%s) - t0 ))
+  speed=$(( ${runs:-0} / (elapsed > 0 ? elapsed : 1) ))
+  printf 'fuzz_%-7s %-6s %10s execs  %7s exec/s  %s  oom inputs %s  (%s s)\n' "$t" "$result" "${runs:-?}" "$speed" "$cov" "${ooms:-0}" "$elapsed"
   if [ "$result" = FAILED ]; then
     grep -E 'ERROR|SUMMARY|Test unit written' "$log" | head -5
     echo "  log: $log"
