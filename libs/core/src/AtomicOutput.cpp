@@ -24,6 +24,17 @@ namespace
 {
 std::string errnoText(int e) { return e ? std::string(std::strerror(e)) : std::string("unknown error"); }
 
+/** Gives the finished temporary file its final name; removes it when that fails. */
+void renameIntoPlace(const std::string& tmp, const std::string& path)
+{
+	if (std::rename(tmp.c_str(), path.c_str()) != 0)
+	{
+		const int e = errno;
+		std::remove(tmp.c_str());
+		throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + errnoText(e));
+	}
+}
+
 /** Runs `produce(tmp)`, then renames tmp to path; removes tmp and names `path` on failure. */
 void produceThenRename(const std::string& path, const std::function<void(const std::string&)>& produce)
 {
@@ -38,12 +49,7 @@ void produceThenRename(const std::string& path, const std::function<void(const s
 		std::remove(tmp.c_str());
 		throw std::runtime_error("cannot write '" + path + "': " + e.what());
 	}
-	if (std::rename(tmp.c_str(), path.c_str()) != 0)
-	{
-		const int e = errno;
-		std::remove(tmp.c_str());
-		throw std::runtime_error("cannot rename '" + tmp + "' to '" + path + "': " + errnoText(e));
-	}
+	renameIntoPlace(tmp, path);
 }
 
 }  // namespace
@@ -144,12 +150,7 @@ void AtomicGzFile::commit()
 		std::remove(m_tmp.c_str());
 		throw std::runtime_error("cannot write '" + m_path + "': " + (rc == Z_ERRNO ? errnoText(e) : "zlib error " + std::to_string(rc)));
 	}
-	if (std::rename(m_tmp.c_str(), m_path.c_str()) != 0)
-	{
-		const int re = errno;
-		std::remove(m_tmp.c_str());
-		throw std::runtime_error("cannot rename '" + m_tmp + "' to '" + m_path + "': " + errnoText(re));
-	}
+	renameIntoPlace(m_tmp, m_path);
 }
 
 void saveGzAtomically(const mrpt::serialization::CSerializable& obj, const std::string& path)

@@ -29,14 +29,6 @@ bool RunOutputs::text(const std::string& file, const std::string& content)
 	return write([&] { core::writeFileAtomically(path(file), content); });
 }
 
-std::string trajectoryText(const core::Trajectory& t, const std::string& header)
-{
-	std::ostringstream o;
-	o << "# " << header << "\n# timestamp tx ty tz qx qy qz qw  (T_world_cam, optical frame)\n";
-	for (const auto& p : t) o << core::tumLine(p) << "\n";
-	return o.str();
-}
-
 namespace
 {
 std::string floorTrajectoryText(const core::Trajectory& traj, const mrpt::poses::CPose3D& T_world_floor)
@@ -87,17 +79,20 @@ std::string loopQueriesCsv(const LoopCloser& loop)
 
 void writeRunFiles(System& sys, const SlamConfig& cfg, const RunFilesInput& in, RunOutputs& out)
 {
-	out.text("trajectory.txt", trajectoryText(in.trajectory, in.trajectoryTitle));
+	auto tum = [&](const char* file, const core::Trajectory& t, const std::string& header) {
+		out.write([&] { core::writeTumTrajectory(out.path(file), t, header); });
+	};
+	tum("trajectory.txt", in.trajectory, in.trajectoryTitle);
 	// The run's floor frame (any map configured): every map output is written in it.
 	if (in.T_world_floor) out.text("trajectory_floor.txt", floorTrajectoryText(in.trajectory, *in.T_world_floor));
 	{
 		// As tracked, before later map refinement (diagnostics: trajectory.txt is the final one).
 		core::Trajectory raw;
 		for (const auto& f : sys.frames()) raw.push_back({f.timestamp, f.T_world_cam});
-		out.text("trajectory_online.txt", trajectoryText(raw, "keygrid-slam online poses (as tracked)"));
+		tum("trajectory_online.txt", raw, "keygrid-slam online poses (as tracked)");
 	}
 	out.text("frames.csv", framesCsv(sys));
-	out.text("keyframes.txt", trajectoryText(sys.keyframeTrajectory(), "keygrid-slam keyframes"));
+	tum("keyframes.txt", sys.keyframeTrajectory(), "keygrid-slam keyframes");
 	// A loaded map's keyframes have their images in the session file, not here.
 	if (!sys.localizeOnly())
 		out.write([&] { writeKeyframesSimpleMap(sys.map(), sys.keyFrameImages(), out.path("keyframes.simplemap")); });

@@ -17,10 +17,8 @@
 #include <keygrid/sfm/SparseMap.h>
 #include <keygrid/slam/KeyFrameImageSource.h>
 #include <mrpt/maps/CSimpleMap.h>
-#include <mrpt/serialization/CArchive.h>
 #include <mrpt/serialization/CSerializable.h>
 
-#include <functional>
 #include <string>
 
 namespace keygrid::slam

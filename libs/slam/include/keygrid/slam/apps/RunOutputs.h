@@ -53,7 +53,4 @@ struct RunFilesInput
  * keyframes.simplemap, scene.3Dscene, loop diagnostics, the pose graph, the metric maps. */
 void writeRunFiles(System& sys, const SlamConfig& cfg, const RunFilesInput& in, RunOutputs& out);
 
-/** The text of a TUM trajectory file with a one-line `header`. */
-std::string trajectoryText(const core::Trajectory& t, const std::string& header);
-
 }  // namespace keygrid::slam
