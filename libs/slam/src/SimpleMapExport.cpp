@@ -3,6 +3,7 @@
 #include <keygrid/core/RgbdObservation.h>
 #include <keygrid/slam/SimpleMapExport.h>
 #include <mrpt/io/CMemoryStream.h>
+#include <mrpt/serialization/CArchive.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/poses/CPose3DPDFGaussian.h>
 
