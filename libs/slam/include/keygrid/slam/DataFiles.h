@@ -8,8 +8,9 @@
 
 namespace keygrid::slam
 {
-/** Folders searched, in order: $KEYGRID_SHARE_DIR (when set), the source tree's share/, the
- * installed <datadir>/keygrid. */
+/** Folders searched, in order: $KEYGRID_SHARE_DIR (when set), share/keygrid beside the running
+ * executable's folder (an installed tool, in whatever prefix), the source tree's share/, the
+ * configured install prefix's <datadir>/keygrid. */
 std::vector<std::string> dataDirectories();
 
 /** Full path of `relative` (e.g. "vocabulary/keygrid_orb_k10_L4.bin") in the first folder of
