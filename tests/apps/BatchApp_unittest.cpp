@@ -208,7 +208,7 @@ TEST(BatchExperiment, AppliesOverridesToACopy)
 	mrpt::config::CConfigFileMemory mem(out);
 	SlamConfig cfg;
 	cfg.loadFromConfigFile(mem);
-	EXPECT_EQ(cfg.mode, "threaded");
+	EXPECT_EQ(cfg.mode, RunMode::Threaded);
 	EXPECT_EQ(cfg.loop.ransac.minInliers, 55);
 	EXPECT_TRUE(cfg.loop.enabled);
 	EXPECT_EQ(cfg.features.numFeatures, 321);

@@ -200,7 +200,7 @@ TEST(LiveCapture, ShippedLiveConfigLoads)
 {
 	const std::string path = test::sourceDir() + "/config/kinect_openni2.ini";
 	const slam::SlamConfig cfg = slam::SlamConfig::FromFile(path);
-	EXPECT_EQ(cfg.mode, "threaded");
+	EXPECT_EQ(cfg.mode, slam::RunMode::Threaded);
 	EXPECT_EQ(cfg.camera, "kinect");
 	mrpt::config::CConfigFile ini(path);
 	const slam::MetricMaps maps(ini, cfg.maps);

@@ -26,12 +26,14 @@ void roundTrip(const std::string& tumDir, const std::string& out, bool external,
 	TumFrameSource tum(tumDir, so);
 	RawlogWriterOptions wo;
 	wo.externalImages = external;
+	std::size_t written = 0;
 	{
 		RawlogWriter w(out, wo);
 		Frame f;
-		while (tum.next(f)) w.write(makeRgbdObservation(f));
+		for (; tum.next(f); written++) w.write(makeRgbdObservation(f));
 		w.close();
 	}
+	ASSERT_GT(written, 0u) << "no frame read from " << tumDir;
 	TumFrameSource again(tumDir, so);
 	RawlogFrameSource rl(out);
 	Frame a, b;
@@ -50,6 +52,7 @@ void roundTrip(const std::string& tumDir, const std::string& out, bool external,
 		++n;
 	}
 	EXPECT_FALSE(rl.next(b));
+	EXPECT_EQ(n, written);
 	EXPECT_EQ(rl.skippedCount(), 0u);
 }
 }  // namespace

@@ -1,8 +1,8 @@
 /** CISMOccupancyGrid2D on keygrid-sim's furnished room, rendered in process with sensor noise,
  * keyframes at ground-truth poses, scored against the simulator's exact floor plan at 5 cm
- * (issue 6: occupied-cell F1 >= 0.9, free-space accuracy >= 95 %). Two walks through the same
+ * (required: occupied-cell F1 >= 0.9, free-space accuracy >= 95 %). Two walks through the same
  * room: config/sim/room_survey.ini (a loop that looks at every wall and piece of furniture: the
- * issue's bounds) and config/sim/room_loop.ini (a circle in the middle, looking outwards: a
+ * required bounds) and config/sim/room_loop.ini (a circle in the middle, looking outwards: a
  * fifth of the plan stays out of view). The full-size experiment (every 10th frame, and
  * keygrid-slam poses) is tests/benchmarks/maps_ism/ism2d_sim_f1.sh; numbers in
  * doc/maps-ism2d.md. */
@@ -149,7 +149,7 @@ TEST(CISMOccupancyGrid2DSim, SparseKeypointsAtGroundTruthPosesMatchFloorPlan)
 	EXPECT_GE(m.freeAccuracyAwayFromOccupied, 0.99);
 }
 
-// Issue 26: the paper's free space calls furniture free (a ray to a wall above a table top frees
+// The paper's free space calls furniture free (a ray to a wall above a table top frees
 // the table's cells); the height band never does, and still frees the floor it saw.
 TEST(CISMOccupancyGrid2DSim, HeightBandCallsNoObstacleFreeWhereThePaperModelDoes)
 {

@@ -1,4 +1,4 @@
-// The run's floor frame (issue 26): the lowest large horizontal plane under the cameras, on a
+// The run's floor frame: the lowest large horizontal plane under the cameras, on a
 // synthetic room where the floor holds 2 % of the depth samples and a table and a sofa top are
 // larger planes (the floor is seen as a strip at the foot of a wall, behind them).
 #include <keygrid/maps/FloorFrameEstimator.h>

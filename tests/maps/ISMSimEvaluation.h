@@ -22,16 +22,7 @@ namespace keygrid::test
  * every cell is scored (the plan covers the room). */
 inline maps::FloorPlanGrid toFloorPlanGrid(const sim::FloorPlan& fp)
 {
-	maps::FloorPlanGrid g;
-	g.resolution = fp.resolution;
-	g.xMin = fp.origin.x();
-	g.yMin = fp.origin.y();
-	g.sizeX = fp.width;
-	g.sizeY = fp.height;
-	g.cells.resize(fp.occupied.size());
-	for (size_t i = 0; i < fp.occupied.size(); i++)
-		g.cells[i] = fp.occupied[i] ? maps::FloorPlanGrid::Occupied : maps::FloorPlanGrid::Free;
-	return g;
+	return maps::FloorPlanGrid::fromOccupancy(fp.resolution, fp.origin.x(), fp.origin.y(), fp.width, fp.height, fp.occupied);
 }
 
 /** Sparse keyframe input standing in for SLAM map points: ORB keypoints of the grey image,

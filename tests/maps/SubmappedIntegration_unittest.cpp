@@ -180,6 +180,34 @@ TEST(SubmappedIntegration, OptionsValidateAndRoundTrip)
 	EXPECT_THROW(big.validate(), std::invalid_argument);
 	big.maxDenseMarkVoxels = 1073741824.0;
 	EXPECT_NO_THROW(big.validate());
+
+	// Every field, changed from its default, comes back through an INI section.
+	DepthIntegrationOptions a;
+	a.maxRange = 3.25;
+	a.minRange = 0.35;
+	a.pixelDecimation = 3;
+	a.threads = 2;
+	a.logOddsHit = 0.75f;
+	a.logOddsMiss = -0.25f;
+	a.logOddsMin = -1.5f;
+	a.logOddsMax = 2.5f;
+	a.discretizeEndpoints = false;
+	a.maxDenseMarkVoxels = 4096.0;
+	mrpt::config::CConfigFileMemory ini;
+	a.saveToConfigFile(ini, "integration");
+	DepthIntegrationOptions b;
+	b.loadFromConfigFile(ini, "integration");
+	EXPECT_DOUBLE_EQ(b.maxRange, a.maxRange);
+	EXPECT_DOUBLE_EQ(b.minRange, a.minRange);
+	EXPECT_EQ(b.pixelDecimation, a.pixelDecimation);
+	EXPECT_EQ(b.threads, a.threads);
+	EXPECT_FLOAT_EQ(b.logOddsHit, a.logOddsHit);
+	EXPECT_FLOAT_EQ(b.logOddsMiss, a.logOddsMiss);
+	EXPECT_FLOAT_EQ(b.logOddsMin, a.logOddsMin);
+	EXPECT_FLOAT_EQ(b.logOddsMax, a.logOddsMax);
+	EXPECT_EQ(b.discretizeEndpoints, a.discretizeEndpoints);
+	EXPECT_DOUBLE_EQ(b.maxDenseMarkVoxels, a.maxDenseMarkVoxels);
+	EXPECT_NO_THROW(b.validate());
 }
 
 TEST(SubmappedIntegration, ResolutionOutsideItsRangeIsRefusedNamingTheKey)

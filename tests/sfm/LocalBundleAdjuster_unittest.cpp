@@ -260,6 +260,76 @@ TEST(LocalBundleAdjuster, APointBehindTheCamerasIsDroppedInsteadOfStoppingTheSol
 		EXPECT_LT((s.map.keyframe(k).T_world_cam - s.truePoses[k]).translation().norm(), 2e-4) << "kf " << k;
 }
 
+namespace
+{
+/** Largest angle [deg] at landmark `id` between the centres of two keyframes observing it, from
+ * the law of cosines on the triangle they form. */
+double largestParallaxDeg(const SparseMap& map, LandmarkId id)
+{
+	const Eigen::Vector3d P = map.landmark(id).p_world;
+	std::vector<Eigen::Vector3d> centres;
+	for (const auto& [kf, kp] : map.landmark(id).observations)
+	{
+		const auto t = map.keyframe(kf).T_world_cam.translation();
+		centres.emplace_back(t.x, t.y, t.z);
+	}
+	double best = 0;
+	for (std::size_t i = 0; i < centres.size(); i++)
+		for (std::size_t j = i + 1; j < centres.size(); j++)
+		{
+			const double a = (P - centres[i]).norm(), b = (P - centres[j]).norm(), c = (centres[i] - centres[j]).norm();
+			best = std::max(best, std::acos((a * a + b * b - c * c) / (2 * a * b)) * 180.0 / M_PI);
+		}
+	return best;
+}
+}  // namespace
+
+TEST(LocalBundleAdjuster, ALandmarkWithoutDepthOrParallaxStaysOut)
+{
+	// The landmarks without depth (odd ids) are seen by keyframes 0 and 3 only; landmark 1 is
+	// moved 5 cm off. At a threshold just below landmark 1's parallax it takes part (and returns
+	// to the truth), just above it it stays out (and where it is); either way exactly the
+	// landmarks without depth whose parallax is below the threshold stay out.
+	for (const double delta : {-0.01, 0.01})
+	{
+		Scene s;
+		buildScene(s, 0.0, 0.0);
+		for (LandmarkId id = 1; id < 80; id += 2)
+		{
+			s.map.eraseObservation(id, 1);
+			s.map.eraseObservation(id, 2);
+		}
+		s.map.landmark(1).p_world += Eigen::Vector3d(0.03, -0.02, 0.035);
+		const Eigen::Vector3d P = s.map.landmark(1).p_world;
+		const double threshold = largestParallaxDeg(s.map, 1) + delta;
+		int expectedOut = 0;
+		for (LandmarkId id = 1; id < 80; id += 2) expectedOut += largestParallaxDeg(s.map, id) < threshold;
+		ASSERT_GT(threshold, 1.0);
+		BundleAdjusterOptions o;
+		o.iterations = 30;
+		o.minParallaxDegWithoutDepth = threshold;
+		const auto rep = localBundleAdjustment(s.map, 3, K, o);
+		EXPECT_EQ(rep.landmarksLeftOut, expectedOut);
+		EXPECT_EQ(rep.landmarks, 80 - expectedOut);
+		if (delta > 0)
+			EXPECT_EQ(s.map.landmark(1).p_world, P);
+		else
+			EXPECT_LT((s.map.landmark(1).p_world - s.truePoints[1]).norm(), 1e-3);
+	}
+	// A landmark with a depth measurement takes part at any threshold: at 90 degrees only the 40
+	// landmarks without depth (odd ids) stay out.
+	Scene s;
+	buildScene(s, 0.01, 0.02);
+	BundleAdjusterOptions o;
+	o.iterations = 30;
+	o.minParallaxDegWithoutDepth = 90.0;
+	const auto rep = localBundleAdjustment(s.map, 3, K, o);
+	EXPECT_EQ(rep.landmarksLeftOut, 40);
+	EXPECT_EQ(rep.landmarks, 40);
+	for (KeyFrameId k = 1; k < 4; k++)
+		EXPECT_LT((s.map.keyframe(k).T_world_cam - s.truePoses[k]).translation().norm(), 2e-4) << "kf " << k;
+}
+
 TEST(LocalBundleAdjuster, SolvedApartFromTheMapAndAppliedToWhatIsStillThere)
 {
 	// Threaded mode's sequence: build from the map, let tracking change the map (a landmark

@@ -1,4 +1,4 @@
-// Issue 8's pruning test on a generated sequence: a fixed camera watches a furnished room in
+// The HOC pruning test on a generated sequence: a fixed camera watches a furnished room in
 // which a box vanishes half-way (tests/data/sim/hoc_vanish.ini). With the HOC the box's
 // landmarks are pruned while the static ones stay; the standard system keeps the box.
 #include <keygrid/core/FrameSource.h>

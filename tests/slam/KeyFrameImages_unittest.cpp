@@ -1,5 +1,5 @@
 /** \file KeyFrameImages_unittest.cpp
- * Keyframe images out of RAM (issue 25): KeyFrameImageCache keeps at most its capacity in RAM
+ * Keyframe images out of RAM: KeyFrameImageCache keeps at most its capacity in RAM
  * (least recently used evicted first) and gives back every image bit-identical from its spill
  * file, which leaves no file behind; StoredKeyFrameImages gives back what a session file holds,
  * the depth bit-identical in metres.

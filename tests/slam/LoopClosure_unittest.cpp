@@ -1,4 +1,4 @@
-// Issue 5's integration test: a generated loop through keygrid-slam closes the loop (reported
+// Loop closing's integration test: a generated loop through keygrid-slam closes the loop (reported
 // with keyframe ids) and meets the accuracy bound; no loop is claimed on real data without one.
 #include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/system/filesystem.h>
@@ -60,7 +60,7 @@ TEST(LoopClosure, GeneratedRoomLoopIsClosed)
 	// 2D/3D maps of config/sim.ini) on their own threads; not bit-identical, same bounds.
 	auto ot = o;
 	ot.output = o.output + "_threaded";
-	ot.modeOverride = "threaded";
+	ot.modeOverride = slam::RunMode::Threaded;
 	const auto rt = slam::runSlam(ot);
 	EXPECT_TRUE(rt.error.empty()) << rt.error;
 	EXPECT_EQ(rt.tracked, 300u);
@@ -83,7 +83,9 @@ TEST(LoopClosure, NoLoopClaimedOnRealFramesWithoutOne)
 	o.input = test::sharedDataDir() + "/tum_fr1_rpy_first250";
 	o.output = test::scratchDir("loop_rpy");
 	o.quiet = true;
-	slam::runSlam(o);
+	const auto r = slam::runSlam(o);
+	ASSERT_TRUE(r.error.empty()) << r.error;
+	EXPECT_EQ(r.frames, 250u);
 	const std::string js = test::readTextFile(o.output + "/report.json");
 	EXPECT_TRUE(nlohmann::json::parse(js)["loop_closures"].empty()) << js;
 }

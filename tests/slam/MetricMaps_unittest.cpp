@@ -96,3 +96,37 @@ TEST(MetricMaps, EveryTwoDimensionalGridTakesTheRunsFloorFrame)
 		EXPECT_NE(std::string(e.what()).find("_insertOpts] T_world_floor"), std::string::npos) << e.what();
 	}
 }
+
+TEST(MetricMaps, AKeyFrameEntersTheGridsAndACorrectionMovesItThere)
+{
+	// One keyframe at the origin facing a flat wall 2.02 m ahead (optical frame: z forward):
+	// the 3D grid holds the wall in the voxel [2.00, 2.05) on the axis and free space before
+	// it. Corrected 0.5 m forward, the wall is in [2.50, 2.55) and its former voxel is free.
+	mrpt::config::CConfigFileMemory ini(
+		"[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
+		"[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.05\n");
+	slam::MetricMaps maps(ini, {});
+	sfm::SparseMap map;
+	sfm::KeyFrame kf;
+	auto& cam = kf.features.camera;
+	cam.width = 64;
+	cam.height = 48;
+	cam.fx = cam.fy = 50.0;
+	cam.cx = 31.5;
+	cam.cy = 23.5;
+	kf.depth = cv::Mat(48, 64, CV_32F, cv::Scalar(2.02f));
+	const sfm::KeyFrameId id = map.addKeyFrame(std::move(kf)).id;
+	maps.insertKeyFrame(map, id, 0.0);
+	const auto* g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>().get();
+	ASSERT_TRUE(g3);
+	auto logOdds = [&](double z) { return g3->logOddsAt(mrpt::math::TPoint3D(0, 0, z)).value_or(0.f); };
+	EXPECT_GT(logOdds(2.025), 0.f);
+	EXPECT_LT(logOdds(1.025), 0.f);
+	EXPECT_EQ(logOdds(2.525), 0.f);  // never observed
+
+	const auto times = maps.applyCorrection({{id, mrpt::poses::CPose3D(0, 0, 0.5, 0, 0, 0)}});
+	EXPECT_EQ(times.count(CSubmappedOccupancyGrid3D::GetRuntimeClassIdStatic().className), 1u);
+	EXPECT_GT(logOdds(2.525), 0.f);
+	EXPECT_LT(logOdds(2.025), 0.f);
+	EXPECT_LT(logOdds(1.525), 0.f);
+}

@@ -1,4 +1,4 @@
-// keygrid-slam's outputs for MRPT's tools (issue 9): keyframes.simplemap rebuilt into the 3D
+// keygrid-slam's outputs for MRPT's tools: keyframes.simplemap rebuilt into the 3D
 // grid by MRPT's observations2map with the plugin preloaded, scene.3Dscene loaded back, and
 // rawlog-edit loading libkeygrid_maps.so. One short synthetic run (keygrid-sim room_arc cut
 // to 40 frames, keygrid-slam config/sim.ini) feeds every test.
@@ -345,7 +345,7 @@ TEST(Outputs, ObservationsToMapRebuildsThe3DGridFromKeyframesSimplemap)
 
 TEST(Outputs, MapOutputsShareTheEstimatedFloorFrame)
 {
-	// Issue 26: one T_world_floor (z up, z = 0 on the floor) for every output. The sim world
+	// One T_world_floor (z up, z = 0 on the floor) for every output. The sim world
 	// is z up with the floor at z = 0 and the SLAM world is the first camera's frame, so the
 	// true floor in the SLAM world is inverse(T_sim_cam0) of the sim's z = 0.
 	const std::string out = runSlamOnShortSimSequence();

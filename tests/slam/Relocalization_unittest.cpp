@@ -1,4 +1,4 @@
-// Relocalization through the vocabulary tree (issue 5): a "kidnapped" sequence jumps from the
+// Relocalization through the vocabulary tree: a "kidnapped" sequence jumps from the
 // far side of a generated room loop back to views of its start, which only old keyframes
 // show. The tracker must find them through the loop closer's keyframe database and continue
 // at the true pose (aligned on the part before the jump, so a look-alike place would show).

@@ -1,4 +1,4 @@
-// Issue 4's integration test: keygrid-sim generates a short sequence, keygrid-slam runs the
+// The frontend's integration test: keygrid-sim generates a short sequence, keygrid-slam runs the
 // shipped config/sim.ini (frontend + both map plugins) on its rawlog, and the trajectory is
 // scored against the simulator's exact ground truth.
 #include <keygrid/core/TumTrajectory.h>
@@ -63,11 +63,11 @@ TEST(SimIntegration, ShippedSimConfigTracksAGeneratedSequenceWithMaps)
 	}
 }
 
-// keygrid-slam's 2D grid finds the floor from its keyframes (issue 6): the camera first looks
-// 33 deg down (beyond the 25 deg the floor may be tilted against one camera's "up"), then
-// 20 deg; the floor is estimated from the pooled depth of the first keyframes with the mean
-// "up" of their cameras. Before, it was estimated from the first keyframe's up only and never
-// found here (the grid stayed in the camera frame). The SLAM world is the first camera frame,
+// keygrid-slam's 2D grid finds the floor from its keyframes: the camera first looks 33 deg
+// down (beyond the 25 deg the floor may be tilted against one camera's "up"), then 20 deg; the
+// floor is estimated from the pooled depth of the first keyframes with the mean "up" of their
+// cameras (the first keyframe's "up" alone would not find it here, and the grid would stay in
+// the camera frame). The SLAM world is the first camera frame,
 // so the floor frame maps into the sim world (z up, floor z = 0) through the first GT pose.
 TEST(SimIntegration, TwoDimensionalGridFindsTheFloorFromKeyframeDepth)
 {

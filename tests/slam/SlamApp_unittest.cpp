@@ -70,7 +70,7 @@ TEST(SlamApp, SequentialRunsAreIdenticalAndThreadedModeMatchesThem)
 		o.maxFrames = 40;
 		o.quiet = true;
 		o.groundTruth = rpy() + "/groundtruth.txt";
-		if (i >= 2) o.modeOverride = "threaded";  // run 3: the default mapping_lag = 1
+		if (i >= 2) o.modeOverride = slam::RunMode::Threaded;  // run 3: the default mapping_lag = 1
 		const auto r = slam::runSlam(o);
 		EXPECT_TRUE(r.error.empty()) << r.error;
 		EXPECT_EQ(r.tracked, 40u);

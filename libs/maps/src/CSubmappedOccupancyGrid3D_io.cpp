@@ -95,9 +95,9 @@ void readGrid(CArchive& in, VoxelBlockGrid& g)
 }
 }  // namespace
 
-// Version 1 (2026-11-21) adds morphingOptions.interpolation after morphingOptions.threads;
+// Version 1 adds morphingOptions.interpolation after morphingOptions.threads;
 // version-0 archives load with Nearest, the behaviour they were written with.
-// Version 2 (2026-11-21) adds morphingOptions.maxKeyframesPerBlock after it (older: 0 = all).
+// Version 2 adds morphingOptions.maxKeyframesPerBlock after it (older: 0 = all).
 uint8_t CSubmappedOccupancyGrid3D::serializeGetVersion() const { return 2; }
 
 void CSubmappedOccupancyGrid3D::serializeTo(mrpt::serialization::CArchive& out) const

@@ -9,6 +9,24 @@
 
 namespace keygrid::maps
 {
+FloorPlanGrid FloorPlanGrid::fromOccupancy(
+	double resolution, double xMin, double yMin, int sizeX, int sizeY, const std::vector<uint8_t>& occupied)
+{
+	if (sizeX < 0 || sizeY < 0 || occupied.size() != static_cast<std::size_t>(sizeX) * static_cast<std::size_t>(sizeY))
+		throw std::invalid_argument(
+			"FloorPlanGrid::fromOccupancy: " + std::to_string(occupied.size()) + " cells for a " + std::to_string(sizeX) +
+			" x " + std::to_string(sizeY) + " lattice");
+	FloorPlanGrid g;
+	g.resolution = resolution;
+	g.xMin = xMin;
+	g.yMin = yMin;
+	g.sizeX = sizeX;
+	g.sizeY = sizeY;
+	g.cells.resize(occupied.size());
+	for (std::size_t i = 0; i < occupied.size(); i++) g.cells[i] = occupied[i] ? Occupied : Free;
+	return g;
+}
+
 FloorPlanGrid::Cell FloorPlanGrid::at(double x, double y) const
 {
 	return cell(

@@ -3,6 +3,7 @@
 
 #include <ceres/ceres.h>
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <set>
 
@@ -164,6 +165,35 @@ struct BundleAdjustment::Problem
 	}
 };
 
+namespace
+{
+/** Whether a landmark's position is observable from its observations: some keyframe measured
+ * its depth, or two observing rays meet at `minParallaxDegWithoutDepth` or more. Along the ray
+ * of an unobservable one the problem is (nearly) singular: a Gauss-Newton step can throw the
+ * point behind a camera, where its residual cannot be evaluated, and Ceres then rejects the
+ * whole step and shrinks its trust region; on a long loop that turned a few such points into
+ * dozens of wasted iterations. */
+bool depthObservable(const SparseMap& map, LandmarkId id, const BundleAdjusterOptions& o)
+{
+	if (o.minParallaxDegWithoutDepth <= 0) return true;
+	const auto& lm = map.landmark(id);
+	std::vector<Eigen::Vector3d> rays;
+	for (const auto& [kf, kp] : lm.observations)
+	{
+		const auto& k = map.keyframe(kf);
+		const float d = k.features.depth[kp];
+		if (d > 0 && d < o.maxDepthForRgbd) return true;
+		const auto c = k.T_world_cam.translation();
+		rays.push_back((lm.p_world - Eigen::Vector3d(c.x, c.y, c.z)).normalized());
+	}
+	const double cosMin = std::cos(o.minParallaxDegWithoutDepth * M_PI / 180.0);
+	for (std::size_t a = 0; a < rays.size(); a++)
+		for (std::size_t b = a + 1; b < rays.size(); b++)
+			if (rays[a].dot(rays[b]) <= cosMin) return true;
+	return false;
+}
+}  // namespace
+
 BundleAdjustment::BundleAdjustment(
 	const SparseMap& map, const std::vector<KeyFrameId>& local, const std::set<KeyFrameId>& fixedSet,
 	const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
@@ -173,10 +203,13 @@ BundleAdjustment::BundleAdjustment(
 	auto& rep = m->report;
 	if (local.empty()) return;
 	std::set<LandmarkId> lmSet;
+	std::set<LandmarkId> leftOut;
 	for (KeyFrameId id : local)
 		for (LandmarkId lm : map.keyframe(id).landmarks)
-			if (lm != kNoLandmark && map.hasLandmark(lm)) lmSet.insert(lm);
+			if (lm != kNoLandmark && map.hasLandmark(lm) && !lmSet.count(lm) && !leftOut.count(lm))
+				(depthObservable(map, lm, o) ? lmSet : leftOut).insert(lm);
 	m->lms.assign(lmSet.begin(), lmSet.end());
+	rep.landmarksLeftOut = static_cast<int>(leftOut.size());
 
 	// --- Parameter blocks.
 	// Parameters live in two contiguous arrays in id order. Ceres orders the blocks of one
@@ -289,6 +322,9 @@ void BundleAdjustment::solve()
 	m->report.initialCost = summary.initial_cost;
 	m->report.finalCost = summary.final_cost;
 	m->report.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+	m->report.solverSeconds = summary.total_time_in_seconds;
+	m->report.evaluationSeconds = summary.residual_evaluation_time_in_seconds + summary.jacobian_evaluation_time_in_seconds;
+	m->report.linearSolverSeconds = summary.linear_solver_time_in_seconds;
 }
 
 BundleAdjusterReport BundleAdjustment::apply(SparseMap& map)

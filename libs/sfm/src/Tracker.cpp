@@ -11,6 +11,34 @@ namespace keygrid::sfm
 {
 namespace
 {
+/** Fewest matches a pose refinement is run on: with fewer, the six pose parameters are barely
+ * constrained and an outlier cannot be told from an inlier. */
+constexpr std::size_t kMinRefinementMatches = 6;
+/** The motion-model search is repeated in a wider window when it finds fewer than this many
+ * times min_matches_prediction: a window that caught so few has missed a change of motion. */
+constexpr int kWideSearchBelowFactor = 2;
+/** Radius of that wider search, a multiple of radius_prediction. */
+constexpr float kWideSearchRadiusFactor = 2.5f;
+/** A relocalization needs this many times min_inliers after its PnP: a look-alike place
+ * (repeated texture) gives a few dozen consistent matches, a true revisit hundreds. */
+constexpr int kRelocalizationInlierFactor = 2;
+/** After a PnP pose the local map is the PnP keyframe and this many of its best covisible
+ * keyframes (until updateLocalKeyFrames rebuilds it from the frame's matches). */
+constexpr int kPnpCovisibleKeyFrames = 10;
+/** Covisible neighbours of each keyframe sharing landmarks with the frame that widen the
+ * local map (up to local_keyframes). */
+constexpr int kLocalMapNeighbours = 5;
+/** keyframe_tracked_ratio while the map has a single keyframe (ORB-SLAM2's 0.4): the second
+ * keyframe waits for a wider baseline to the first than later keyframes do. */
+constexpr double kTrackedRatioWithOneKeyFrame = 0.4;
+/** A keyframe needs more inliers than this (ORB-SLAM2's 15): a barely tracked frame would
+ * bring a poor pose into the map. */
+constexpr int kMinKeyFrameInliers = 15;
+
+/** Inliers a pose needs before the local-map search (motion model, or PnP on the reference
+ * keyframe): half of min_inliers, the search adds the matches that reach min_inliers. */
+int firstStageMinInliers(const TrackerOptions& o) { return o.minInliers / 2; }
+
 double threadCpuSeconds()
 {
 	timespec ts{};
@@ -25,6 +53,24 @@ Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float 
 }
 
 PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& c) { return {c.fx, c.fy, c.cx, c.cy}; }
+
+const char* toString(TrackingMethod m)
+{
+	switch (m)
+	{
+		case TrackingMethod::Init:
+			return "init";
+		case TrackingMethod::Prediction:
+			return "prediction";
+		case TrackingMethod::Pnp:
+			return "pnp";
+		case TrackingMethod::Relocalization:
+			return "relocalization";
+		case TrackingMethod::Lost:
+			return "lost";
+	}
+	return "?";
+}
 
 Tracker::Tracker(SparseMap& map, const TrackerOptions& opts) : m_map(map), m_opts(opts)
 {
@@ -45,8 +91,8 @@ void Tracker::deferKeyFramesWhile(std::function<bool()> mappingBusy, double weak
 
 bool Tracker::hocUsable(LandmarkId id, const Current& cur)
 {
-	// Untimed: callers time whole selection passes. A thread-CPU clock read costs ~1 us here,
-	// more than the selection of one landmark, so timing each call inflated the HOC cost.
+	// Untimed: callers time whole selection passes, as a thread-CPU clock read costs more than
+	// the selection of one landmark.
 	return !m_hoc || hocUsable(m_map.landmark(id), cur);
 }
 
@@ -70,7 +116,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 	{
 		if (!initialize(cur, out))
 		{
-			out.method = "lost";
+			out.method = TrackingMethod::Lost;
 			out.T_world_cam = m_lastPose;
 		}
 		return out;
@@ -119,7 +165,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		m_lastTimestamp = frame.timestamp;
 		m_state = TrackingState::Ok;
 		m_framesLost = 0;
-		if (out.method != "relocalization" && cur.localMapInView > 0)
+		if (out.method != TrackingMethod::Relocalization && cur.localMapInView > 0)
 		{
 			m_recentShares.push_back(static_cast<double>(cur.inliers) / cur.localMapInView);
 			if (m_recentShares.size() > kRecentShares) m_recentShares.pop_front();
@@ -154,7 +200,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 		m_state = TrackingState::Lost;
 		m_velocity.reset();
 		++m_framesLost;
-		out.method = "lost";
+		out.method = TrackingMethod::Lost;
 		cur.T_world_cam = m_lastPose;  // best guess until relocalized
 	}
 	out.tracked = ok;
@@ -204,28 +250,28 @@ bool Tracker::attempt(Current& cur, TrackedFrame& out)
 		// have moved tens of pixels: match descriptors against the reference keyframe first.
 		if (!m_velocity)
 		{
-			ok = trackByPnp(cur, m_refKf, m_opts.minInliers / 2);
-			out.method = "pnp";
+			ok = trackByPnp(cur, m_refKf, firstStageMinInliers(m_opts));
+			out.method = TrackingMethod::Pnp;
 		}
 		if (!ok)
 		{
 			cur.matches.assign(cur.features.size(), kNoLandmark);
 			cur.T_world_cam = m_velocity ? m_lastPose + *m_velocity : m_lastPose;
 			ok = trackByPrediction(cur);
-			out.method = "prediction";
+			out.method = TrackingMethod::Prediction;
 		}
 		if (!ok)
 		{
 			cur.matches.assign(cur.features.size(), kNoLandmark);
 			cur.T_world_cam = m_lastPose;
-			ok = trackByPnp(cur, m_refKf, m_opts.minInliers / 2);
-			out.method = "pnp";
+			ok = trackByPnp(cur, m_refKf, firstStageMinInliers(m_opts));
+			out.method = TrackingMethod::Pnp;
 		}
 	}
 	else
 	{
 		ok = relocalize(cur);
-		out.method = "relocalization";
+		out.method = TrackingMethod::Relocalization;
 	}
 	if (ok)
 	{
@@ -234,7 +280,7 @@ bool Tracker::attempt(Current& cur, TrackedFrame& out)
 		ok = cur.inliers >= m_opts.minInliers;
 		// A look-alike place matches a few dozen landmarks of a local map that shows hundreds
 		// in view; the true place matches a good share of them.
-		if (ok && out.method == "relocalization")
+		if (ok && out.method == TrackingMethod::Relocalization)
 		{
 			ok = cur.inliers >= requiredRelocalizationShare(m_opts, {m_recentShares.begin(), m_recentShares.end()}) * cur.localMapInView;
 			out.relocalizationKeyFrame = m_refKf;
@@ -289,7 +335,7 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	m_velocityDt = 0;
 	m_state = TrackingState::Ok;
 	out.tracked = true;
-	out.method = "init";
+	out.method = TrackingMethod::Init;
 	out.inliers = out.matches = static_cast<int>(m_map.numLandmarks());
 	out.newKeyFrame = true;
 	out.keyframe = id;
@@ -364,7 +410,7 @@ int Tracker::refinePose(Current& cur, bool anchored)
 		obs.push_back(o);
 		kpOf.push_back(static_cast<int>(i));
 	}
-	if (obs.size() < 6) return 0;
+	if (obs.size() < kMinRefinementMatches) return 0;
 	PoseOptimizerResult r;
 	if (anchored && m_opts.anchorMinKeyFrames > 0)
 	{
@@ -387,13 +433,13 @@ bool Tracker::trackByPrediction(Current& cur)
 	auto cands = projectLocalLandmarks(cur, false);
 	int n = searchByProjection(cur.features, cands, m_opts.radiusPrediction, m_opts.matcher, cur.matches);
 	// Few matches in the window: the motion changed; search wider before giving up.
-	if (n < 2 * m_opts.minMatchesPrediction)
+	if (n < kWideSearchBelowFactor * m_opts.minMatchesPrediction)
 	{
 		cur.matches.assign(cur.features.size(), kNoLandmark);
-		n = searchByProjection(cur.features, cands, 2.5f * m_opts.radiusPrediction, m_opts.matcher, cur.matches);
+		n = searchByProjection(cur.features, cands, kWideSearchRadiusFactor * m_opts.radiusPrediction, m_opts.matcher, cur.matches);
 	}
 	if (n < m_opts.minMatchesPrediction) return false;
-	return refinePose(cur) >= m_opts.minInliers / 2;
+	return refinePose(cur) >= firstStageMinInliers(m_opts);
 }
 
 bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minRefinedInliers)
@@ -428,7 +474,7 @@ bool Tracker::trackByPnp(Current& cur, KeyFrameId kfId, int minRefinedInliers)
 	const int inl = refinePose(cur);
 	if (inl < minRefinedInliers) return false;
 	m_localKfs = {kfId};
-	for (KeyFrameId n : m_map.bestCovisibles(kfId, 10)) m_localKfs.push_back(n);
+	for (KeyFrameId n : m_map.bestCovisibles(kfId, kPnpCovisibleKeyFrames)) m_localKfs.push_back(n);
 	return true;
 }
 
@@ -448,9 +494,7 @@ bool Tracker::relocalize(Current& cur)
 		if (!m_map.hasKeyFrame(id)) continue;
 		cur.matches.assign(cur.features.size(), kNoLandmark);
 		cur.T_world_cam = m_map.keyframe(id).T_world_cam;
-		// A look-alike place (repeated texture) can give a few dozen consistent matches; a
-		// true revisit gives hundreds, so relocalization asks for twice the tracking minimum.
-		if (trackByPnp(cur, id, 2 * m_opts.minInliers))
+		if (trackByPnp(cur, id, kRelocalizationInlierFactor * m_opts.minInliers))
 		{
 			m_refKf = id;
 			m_relocRecognized = recognized.count(id) > 0;
@@ -482,7 +526,7 @@ void Tracker::updateLocalKeyFrames(const Current& cur)
 	// Neighbours of the strongest ones widen the local map.
 	const std::size_t base = m_localKfs.size();
 	for (std::size_t i = 0; i < base && static_cast<int>(m_localKfs.size()) < m_opts.localKeyFrames; i++)
-		for (KeyFrameId n : m_map.bestCovisibles(m_localKfs[i], 5))
+		for (KeyFrameId n : m_map.bestCovisibles(m_localKfs[i], kLocalMapNeighbours))
 			if (static_cast<int>(m_localKfs.size()) < m_opts.localKeyFrames && in.insert(n).second) m_localKfs.push_back(n);
 	// The reference keyframe: the one sharing most landmarks.
 	m_refKf = v.front().second;
@@ -530,7 +574,8 @@ bool Tracker::needKeyFrame(const Current& cur) const
 {
 	const int sinceLast = static_cast<int>(cur.frame->index - m_lastKfFrame);
 	// Landmarks of the reference keyframe also seen by other keyframes (ORB-SLAM2's "3
-	// observations", where an RGB-D observation counts twice, is 2 keyframes).
+	// observations", where an RGB-D observation counts twice, is 2 keyframes); all of them
+	// while the map has one or two keyframes.
 	const int minObs = m_map.numKeyFrames() > 2 ? m_opts.keyFrameRefMinObservations : 1;
 	const int refMatches = m_map.hasKeyFrame(m_refKf) ? m_map.keyframe(m_refKf).trackedLandmarks(minObs, &m_map) : 0;
 	int trackedClose = 0, newClose = 0;
@@ -541,12 +586,12 @@ bool Tracker::needKeyFrame(const Current& cur) const
 		(cur.matches[i] != kNoLandmark ? trackedClose : newClose)++;
 	}
 	const bool needClose = trackedClose < m_opts.minTrackedClose && newClose > m_opts.minNewClose;
-	const double ratio = m_map.numKeyFrames() < 2 ? 0.4 : m_opts.keyFrameTrackedRatio;
+	const double ratio = m_map.numKeyFrames() < 2 ? kTrackedRatioWithOneKeyFrame : m_opts.keyFrameTrackedRatio;
 	const bool timeout = sinceLast >= m_opts.maxFramesBetweenKeyFrames;
 	const bool weak = cur.inliers < ratio * refMatches || needClose;
 	// Local mapping still busy with the last keyframe: wait for it unless tracking is weak.
 	if (!timeout && m_mappingBusy && !(cur.inliers < m_deferWeakRatio * refMatches) && m_mappingBusy()) return false;
-	return (timeout || weak) && cur.inliers > 15;
+	return (timeout || weak) && cur.inliers > kMinKeyFrameInliers;
 }
 
 KeyFrameId Tracker::createKeyFrame(const Current& cur)

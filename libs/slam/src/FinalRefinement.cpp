@@ -1,4 +1,5 @@
 #include <keygrid/slam/FinalRefinement.h>
+#include <keygrid/sfm/BundleWindow.h>
 
 #include <algorithm>
 #include <future>
@@ -15,6 +16,28 @@ std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<LoopClosureEvent
 	}
 	if (map.numKeyFrames() > 0) seeds.push_back(map.keyframes().rbegin()->first);
 	return seeds;
+}
+
+FinalBundleAdjustment finalBundleAdjustment(
+	sfm::SparseMap& map, const sfm::PinholeIntrinsics& K, const std::vector<LoopClosureEvent>& loops,
+	const RefinementOptions& rc, const sfm::LocalMapperOptions& mapping)
+{
+	auto o = mapping.ba;
+	o.iterations = rc.globalIterations;
+	o.functionTolerance = 1e-6;
+	// The landmarks local mapping would not have triangulated without depth stay out.
+	o.minParallaxDegWithoutDepth = mapping.minParallaxDeg;
+	FinalBundleAdjustment out;
+	const auto maxKf = static_cast<std::size_t>(rc.globalMaxKeyFrames);
+	if (maxKf > 0 && map.numKeyFrames() > maxKf)
+	{
+		const auto w = sfm::growBundleWindow(map, finalWindowSeeds(loops, map), maxKf);
+		out.window.emplace(w.local.begin(), w.local.end());
+		out.report = sfm::bundleAdjust(map, w.local, w.fixed, K, o);
+	}
+	else
+		out.report = sfm::globalBundleAdjustment(map, K, o);
+	return out;
 }
 
 double largestDisplacement(

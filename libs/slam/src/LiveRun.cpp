@@ -93,7 +93,7 @@ LiveLoopResult runLiveLoop(
 		{
 			char status[160];
 			std::snprintf(status, sizeof(status), "frame %zu  %s  inliers %d  keyframes %zu  dropped %zu",
-						  tf.index, tf.tracked ? tf.method.c_str() : "LOST", tf.inliers, sys.numKeyFrames(),
+						  tf.index, tf.tracked ? sfm::toString(tf.method) : "LOST", tf.inliers, sys.numKeyFrames(),
 						  source.droppedCount());
 			preview->show(e->frame, keypoints, tf, status);
 			if (preview->closed())

@@ -5,6 +5,7 @@
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/CMatrixFixed.h>
 
+#include <algorithm>
 #include <chrono>
 #include <set>
 
@@ -34,6 +35,60 @@ mrpt::poses::CPose3D toCPose3D(const Eigen::Isometry3d& T)
 		t[i] = T.translation()(i);
 	}
 	return mrpt::poses::CPose3D::FromRotationAndTranslation(R, t);
+}
+
+const char* toString(LoopQueryOutcome o)
+{
+	switch (o)
+	{
+		case LoopQueryOutcome::Closed:
+			return "closed";
+		case LoopQueryOutcome::NoVocabulary:
+			return "no_vocabulary";
+		case LoopQueryOutcome::AfterLoop:
+			return "after_loop";
+		case LoopQueryOutcome::NoCandidate:
+			return "no_candidate";
+		case LoopQueryOutcome::NotConsistent:
+			return "not_consistent";
+		case LoopQueryOutcome::FewMatches:
+			return "few_matches";
+		case LoopQueryOutcome::RansacFailed:
+			return "ransac_failed";
+		case LoopQueryOutcome::Implausible:
+			return "implausible";
+		case LoopQueryOutcome::MergePending:
+			return "merge_pending";
+		case LoopQueryOutcome::MergeSeenThrough:
+			return "merge_seen_through";
+		case LoopQueryOutcome::PoseGraphFailed:
+			return "pose_graph_failed";
+	}
+	return "?";
+}
+
+loop::VocabularyOptions LoopClosingOptions::trainingVocabularyDefaults()
+{
+	loop::VocabularyOptions o;
+	o.branching = 10;
+	o.levels = 3;
+	o.maxIterations = 10;
+	o.seed = 1;
+	o.threads = 1;
+	return o;
+}
+
+loop::RigidRansacOptions LoopClosingOptions::verificationRansacDefaults()
+{
+	loop::RigidRansacOptions o;
+	o.inlierThreshold = 0.04;
+	o.minInliers = 40;
+	o.maxIterations = 300;
+	o.confidence = 0.999;
+	o.refinementRounds = 5;
+	o.estimateScale = false;
+	o.seed = 42;
+	return o;
 }
 
 void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
@@ -159,6 +214,12 @@ std::vector<sfm::KeyFrameId> LoopCloser::placeCandidates(const cv::Mat& descript
 	return out;
 }
 
+int LoopCloser::rejectedImplausible() const
+{
+	return static_cast<int>(std::count_if(
+		m_queries.begin(), m_queries.end(), [](const LoopQueryRecord& q) { return q.outcome == LoopQueryOutcome::Implausible; }));
+}
+
 std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const loop::BowVector& bow, double& score, LoopQueryRecord& rec)
 {
 	const auto t0 = std::chrono::steady_clock::now();
@@ -220,14 +281,14 @@ bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::Pi
 	rec.matches = static_cast<int>(pa.size());
 	if (static_cast<int>(pa.size()) < m_opts.ransac.minInliers)
 	{
-		rec.outcome = "few_matches";
+		rec.outcome = LoopQueryOutcome::FewMatches;
 		return false;
 	}
 	const auto r = loop::estimateRigidTransformRansac(pa, pb, m_opts.ransac);
 	rec.inliers = r.numInliers;
 	if (!r.success)
 	{
-		rec.outcome = "ransac_failed";
+		rec.outcome = LoopQueryOutcome::RansacFailed;
 		return false;
 	}
 	T_cand_cur = r.T_a_b;
@@ -255,7 +316,7 @@ bool LoopCloser::mergeConfirmed(
 	rec.seenThroughRatio = seen.ratio();
 	if (seen.ratio() > m_opts.mergeMaxSeenThrough)
 	{
-		rec.outcome = "merge_seen_through";
+		rec.outcome = LoopQueryOutcome::MergeSeenThrough;
 		return false;
 	}
 	bool agrees = false;
@@ -273,7 +334,7 @@ bool LoopCloser::mergeConfirmed(
 	m_merge->align = align;
 	if (m_merge->count < m_opts.mergeConsistency)
 	{
-		rec.outcome = "merge_pending";
+		rec.outcome = LoopQueryOutcome::MergePending;
 		return false;
 	}
 	m_merge.reset();
@@ -394,14 +455,13 @@ std::optional<LoopClosureEvent> LoopCloser::closeVerifiedLoop(
 {
 	if (!plausible(kf, cand, T_cand_cur))
 	{
-		rejectedImplausible++;
-		rec.outcome = "implausible";
+		rec.outcome = LoopQueryOutcome::Implausible;
 		return std::nullopt;
 	}
 	auto ev = correct(kf, cand, T_cand_cur, K);
 	if (ev.newPoses.empty())
 	{
-		rec.outcome = "pose_graph_failed";
+		rec.outcome = LoopQueryOutcome::PoseGraphFailed;
 		return std::nullopt;
 	}
 	ev.frameIndex = frameIndex;
@@ -414,7 +474,7 @@ std::optional<LoopClosureEvent> LoopCloser::closeVerifiedLoop(
 	m_lastLoopKf = kf;
 	m_anyLoop = true;
 	m_consistency.reset();
-	rec.outcome = "closed";
+	rec.outcome = LoopQueryOutcome::Closed;
 	return ev;
 }
 
@@ -436,7 +496,7 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 	if (m_vocab.empty())
 	{
 		trainIfReady();
-		rec.outcome = "no_vocabulary";
+		rec.outcome = LoopQueryOutcome::NoVocabulary;
 		m_queries.push_back(rec);
 		return std::nullopt;
 	}
@@ -447,9 +507,9 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 	std::optional<LoopClosureEvent> out;
 	// No detection right after a loop: the map around it is still being joined.
 	if (m_anyLoop && kf <= m_lastLoopKf + 5)
-		rec.outcome = "after_loop";
+		rec.outcome = LoopQueryOutcome::AfterLoop;
 	else if (auto cand = detect(kf, bow, score, rec); !cand)
-		rec.outcome = rec.candidates ? "not_consistent" : "no_candidate";
+		rec.outcome = rec.candidates ? LoopQueryOutcome::NotConsistent : LoopQueryOutcome::NoCandidate;
 	else
 	{
 		rec.verifiedCandidate = *cand;

@@ -9,16 +9,24 @@
 
 namespace keygrid::slam
 {
+const char* toString(RunMode m) { return m == RunMode::Threaded ? "threaded" : "sequential"; }
+
+RunMode runModeFromString(const std::string& text, const std::string& what)
+{
+	if (text == "sequential") return RunMode::Sequential;
+	if (text == "threaded") return RunMode::Threaded;
+	throw std::invalid_argument(what + " '" + text + "' (expected sequential or threaded)");
+}
+
 void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 {
-	mode = c.read_string("slam", "mode", mode);
+	const std::string modeText = c.read_string("slam", "mode", toString(mode));
 	camera = c.read_string("slam", "camera", camera);
 	mappingLag = c.read_int("slam", "mapping_lag", mappingLag);
 	busyKeyFrameRatio = c.read_double("slam", "busy_keyframe_ratio", busyKeyFrameRatio);
 	if (!(busyKeyFrameRatio >= 0 && busyKeyFrameRatio <= 1))
 		throw std::invalid_argument("[slam] busy_keyframe_ratio = " + std::to_string(busyKeyFrameRatio) + " (expected 0..1)");
-	if (mode != "sequential" && mode != "threaded")
-		throw std::invalid_argument("[slam] mode = '" + mode + "' (expected sequential or threaded)");
+	mode = runModeFromString(modeText, "[slam] mode =");
 	if (mappingLag < 0 || mappingLag > 5)
 		throw std::invalid_argument("[slam] mapping_lag = " + std::to_string(mappingLag) + " (expected 0..5)");
 	features.loadFromConfigFile(c, "features");
@@ -50,7 +58,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 
 void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 {
-	c.write("slam", "mode", mode, 30, 40, "sequential | threaded");
+	c.write("slam", "mode", std::string(toString(mode)), 30, 40, "sequential | threaded");
 	c.write("slam", "camera", camera.empty() ? std::string("auto") : camera, 30, 40, "preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
 	c.write("slam", "mapping_lag", mappingLag, 30, 40, "threaded: keyframes local mapping may lag behind tracking (0: none)");
 	c.write("slam", "busy_keyframe_ratio", busyKeyFrameRatio, 30, 40, "threaded, lag > 0: no keyframe while mapping is busy unless tracking < this x reference (0: off)");

@@ -32,7 +32,7 @@ System::System(const SlamConfig& cfg)
 		// Relocalization asks the loop closer's keyframe database (vocabulary tree) first.
 		m_tracker.setPlaceRecognizer([this](const sfm::FrameFeatures& f, int n) { return m_loopCloser->placeCandidates(f.descriptors, n); });
 	}
-	if (cfg.mode == "threaded")
+	if (cfg.mode == RunMode::Threaded)
 	{
 		// A few keyframes may wait for local mapping; beyond that tracking waits (back pressure
 		// instead of an ever longer backlog on a slow machine).
@@ -175,8 +175,8 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		if (tf.tracked) m_stats.tracked++;
 		else
 			m_stats.lost++;
-		if (tf.method == "relocalization" && tf.tracked) m_stats.relocalizations++;
-		if (tf.method == "pnp" && tf.tracked) m_stats.pnpFallbacks++;
+		if (tf.method == sfm::TrackingMethod::Relocalization && tf.tracked) m_stats.relocalizations++;
+		if (tf.method == sfm::TrackingMethod::Pnp && tf.tracked) m_stats.pnpFallbacks++;
 	}
 	const bool queueKeyFrame = tf.newKeyFrame && m_mappingQueue;
 	m_frames.push_back(std::move(tf));
@@ -432,19 +432,9 @@ void System::finish()
 	std::optional<std::set<sfm::KeyFrameId>> window;
 	if (rc.globalBundleAdjustment && m_map.numKeyFrames() > 1 && !m_localizeOnly)
 	{
-		auto o = m_cfg.mapping.ba;
-		o.iterations = rc.globalIterations;
-		// Once per run: to convergence (Ceres' default tolerance), not the local windows' early stop.
-		o.functionTolerance = 1e-6;
-		const auto maxKf = static_cast<std::size_t>(rc.globalMaxKeyFrames);
-		if (maxKf > 0 && m_map.numKeyFrames() > maxKf)
-		{
-			const auto w = sfm::growBundleWindow(m_map, finalWindowSeeds(m_loops, m_map), maxKf);
-			window.emplace(w.local.begin(), w.local.end());
-			m_globalBa = sfm::bundleAdjust(m_map, w.local, w.fixed, *m_K, o);
-		}
-		else
-			m_globalBa = sfm::globalBundleAdjustment(m_map, *m_K, o);
+		auto ba = finalBundleAdjustment(m_map, *m_K, m_loops, rc, m_cfg.mapping);
+		m_globalBa = ba.report;
+		window = std::move(ba.window);
 	}
 	m_timings.add("global_bundle_adjustment", secondsSince(t0));
 	if (m_maps && !m_localizeOnly)

@@ -11,7 +11,7 @@ namespace keygrid::store
 {
 namespace
 {
-// A serialized map over 16 GiB cannot be a snapshot keygrid wrote on a 24 GB machine; the bound
+// A serialized map over 16 GiB is larger than any snapshot keygrid writes; the bound
 // keeps a damaged length from claiming all memory.
 constexpr std::size_t kMaxSnapshotBytes = std::size_t{16} << 30;
 }  // namespace

@@ -1,6 +1,6 @@
 #!/bin/bash
 # HOC on a static real sequence, with the run-to-run spread of ORB feature selection averaged
-# out (issue 8's "no worse than std within 10 %", doc/evaluation.md): tum_fr1_rpy_first250 with
+# out (the target "no worse than std within 10 %", doc/evaluation.md): tum_fr1_rpy_first250 with
 # config/tum_fr1.ini, [hoc] enabled = false / true, at num_features 980, 990, 1000, 1010, 1020.
 # A budget change of 1 % moves single runs by up to 25 %, so one run does not compare the rules.
 # Usage: tests/benchmarks/hoc/run_fr1_budgets.sh [BUILD_DIR=build] [OUT_DIR=out/hoc_fr1]

@@ -1,5 +1,5 @@
 #!/bin/bash
-# HOC experiments (issue 8, doc/evaluation.md "HOC point map"): the standard system ([hoc]
+# HOC experiments (doc/evaluation.md "HOC point map"): the standard system ([hoc]
 # enabled = false) against HOC on the dynamic keygrid-sim scenes, a static scene, and — when
 # ../shared/data is present — tum_fr1_rpy_first250 and its augmented (dynamic objects) version.
 # For each: TE = ATE RMSE [mm], RE = orientation RMSE [deg] (keygrid-slam report.json,

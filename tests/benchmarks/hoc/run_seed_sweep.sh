@@ -1,6 +1,6 @@
 #!/bin/bash
-# The walker scenes of the HOC experiments over several simulator seeds (issue 8,
-# doc/evaluation.md "Seed sweep"): a single seed of a dynamic scene can swing by a factor of 10
+# The walker scenes of the HOC experiments over several simulator seeds
+# (doc/evaluation.md "Seed sweep"): a single seed of a dynamic scene can swing by a factor of 10
 # (whether the walkers pull the pose off depends on sub-pixel details), so the comparison of
 # std ([hoc] enabled = false) and HOC is made over seeds. Each seed renders the same scene with
 # other sensor noise (keygrid-sim --seed).

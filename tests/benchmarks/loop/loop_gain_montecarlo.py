@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""How much lower can one loop closure make the ATE?  (issue 5, doc/evaluation.md "Batch")
+"""How much lower can one loop closure make the ATE?  (doc/evaluation.md "Batch")
 
 Monte Carlo on a planar SE(2) pose graph: a camera drives a circle of N steps; odometry
 measures each step with an error; one loop constraint (start = end, 10x more precise than a

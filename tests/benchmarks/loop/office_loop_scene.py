@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-# Writes config/sim/office_loop.ini (the long corridor loop of the loop-closing evaluation, issue 5):
+# Writes config/sim/office_loop.ini (the long corridor loop of the loop-closing evaluation):
 #   python3 tests/benchmarks/loop/office_loop_scene.py > config/sim/office_loop.ini
 W, H, C, Z = 16.0, 10.0, 1.6, 2.6   # outer size, corridor width, height
 out = []
@@ -47,7 +47,7 @@ sec('shelf_in_n', type='box', centre=f(11.0, H - C - 0.15, 0.9), size=f(1.2, 0.3
 sec('printer_in_s', type='box', centre=f(10.0, C + 0.25, 0.45), size=f(0.6, 0.5, 0.9), colour='90 90 100')
 head = """# keygrid-sim scene: an office floor's corridor loop (outer walls 16 m x 10 m around a 12.8 m x
 # 6.8 m block of offices, corridors 1.6 m wide, 2.6 m high); the camera walks the 44 m loop once,
-# counter-clockwise, looking ahead, and returns to its start: the long loop of issue 5's
+# counter-clockwise, looking ahead, and returns to its start: the long loop of the
 # loop-closing evaluation: corridor_loop's kind of world (textures, furniture, sensor) at 3x its
 # length. Walls, floor and ceiling are split into pieces of at most 2 m so that each carries its
 # own texture tile: a 2 m tile repeated along a 16 m wall would make the corridor periodic (look-

@@ -1,6 +1,6 @@
 /** CISMOccupancyGrid2D speed: one sparse keyframe (map points), one dense 640x480 depth image,
  * and the rebuild of N keyframes after a trajectory correction. Scene: the synthetic 4 x 3 m
- * room of the unit tests, 5 cm cells. Targets (issue 6): <= 1 ms sparse, <= 5 ms dense. */
+ * room of the unit tests, 5 cm cells. Targets: <= 1 ms sparse, <= 5 ms dense. */
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 
 #include <benchmark/benchmark.h>

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Floor-frame benchmark (issue 26): keygrid-slam's estimated T_world_floor against the true
+# Floor-frame benchmark: keygrid-slam's estimated T_world_floor against the true
 # floor of every shipped synthetic scene with a floor plan. The sim world is z-up with the
 # floor at z = 0; the SLAM world is carried into it by the SE(3) Umeyama alignment of
 # trajectory.txt to groundtruth.txt, and each accepted estimate of report.json's "floor"

@@ -1,6 +1,6 @@
 /** \file ism2d_sim_eval.cpp
  * keygrid_ism2d_sim_eval: accuracy of CISMOccupancyGrid2D against keygrid-sim's floor plan
- * (issue 6: occupied-cell F1 and free-space accuracy at 5 cm).
+ * (occupied-cell F1 and free-space accuracy at 5 cm).
  *
  *   keygrid_ism2d_sim_eval --sim SIMDIR [--every 10] [--input sparse|dense|both]
  *       [--poses gt|TRAJ.txt] [--align first|umeyama] [--slam-map map_2d.yaml] [--save PREFIX]

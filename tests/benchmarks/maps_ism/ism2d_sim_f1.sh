@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 6 accuracy benchmark: CISMOccupancyGrid2D against keygrid-sim's floor plan (5 cm cells)
+# Accuracy benchmark: CISMOccupancyGrid2D against keygrid-sim's floor plan (5 cm cells)
 # on a room scene (default config/sim/room_survey.ini; also run it with room_loop.ini), with
 # ground-truth poses and with keygrid-slam's poses, sparse (ORB keypoints + depth) and dense
 # input, and keygrid-slam's own map_2d (config/sim.ini, i.e. sparse map points and RANSAC floor;

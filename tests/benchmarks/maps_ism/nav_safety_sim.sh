@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 26 benchmark: how navigation-safe keygrid-slam's own 2D map is on every shipped synthetic
+# Benchmark: how navigation-safe keygrid-slam's own 2D map is on every shipped synthetic
 # scene with a floor plan. For each scene: render it with keygrid-sim (cached), run keygrid-slam
 # with config/sim.ini (its own poses, floor estimated) for every free-space model x 2D input, and
 # score map_2d against the floor plan with keygrid-eval's map mode (visibility rendered at the
@@ -28,7 +28,7 @@
 #   --tag NAME         suffix of the run folders, to keep runs with other --set apart (default: none)
 #
 # The model is passed as --set 'MappingApplication_ismOccupancyGrid2D_00_insertOpts.freeSpaceModel=M'.
-# A keygrid-slam that does not know the key (before issue 26's grid) rejects it; the script then
+# A keygrid-slam that does not know the key (before the height-band grid) rejects it; the script then
 # runs "paper" without the key (that grid IS the paper's model) and reports the other models n/a.
 set -uo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 25 benchmark: memory and per-frame cost of keygrid-slam over a long run, and the cost of
+# Benchmark: memory and per-frame cost of keygrid-slam over a long run, and the cost of
 # its final step. Runs keygrid-slam once on the synthetic 44 m office_loop (3300 frames) with
 # config/sim.ini (every map on: 2D ISM grid, submapped 3D grid, HOC points; sequential mode) and
 # prints one markdown table row from its report.json:
@@ -13,7 +13,7 @@
 #   final step [s]                   timings "finish": global bundle adjustment, map
 #                                    re-anchoring, frame refinement (each also listed)
 #   ATE [cm]                         against the scene's ground truth
-# Targets (issue 25): growth <= 0.5 MB/kf, max RSS <= 600 MB, last/first <= 1.2, final <= 3 s.
+# Targets: growth <= 0.5 MB/kf, max RSS <= 600 MB, last/first <= 1.2, final <= 3 s.
 # Timings depend on the machine's load: run it on an idle machine, or with `nice` beside others.
 #
 #   tests/benchmarks/slam/office_loop_memory.sh [--build DIR] [--out DIR] [--sim DIR]

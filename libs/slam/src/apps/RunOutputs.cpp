@@ -50,7 +50,7 @@ std::string framesCsv(const System& sys)
 	{
 		char line[180];
 		std::snprintf(line, sizeof(line), "%zu,%.6f,%d,%s,%d,%d,%d,%lld,%zu%s\n", f.index, f.timestamp, f.tracked ? 1 : 0,
-					  f.method.c_str(), f.matches, f.inliers, f.newKeyFrame ? 1 : 0,
+					  sfm::toString(f.method), f.matches, f.inliers, f.newKeyFrame ? 1 : 0,
 					  f.hasReference ? static_cast<long long>(f.reference) : -1LL, f.mapLandmarks,
 					  !sys.localizeOnly() ? "" : f.tracked ? ",localized" : ",lost");
 		csv << line;
@@ -67,7 +67,7 @@ std::string loopQueriesCsv(const LoopCloser& loop)
 	{
 		char line[256];
 		std::snprintf(line, sizeof(line), "%llu,%zu,%s,%.4f,%d,%s,%.4f,%s,%d,%d,%.3f,%.4f\n", static_cast<unsigned long long>(q.keyframe),
-					  q.frameIndex, q.outcome.c_str(), q.referenceScore, q.candidates,
+					  q.frameIndex, toString(q.outcome), q.referenceScore, q.candidates,
 					  q.candidates ? std::to_string(q.bestCandidate).c_str() : "", q.bestScore,
 					  q.verifiedCandidate ? std::to_string(*q.verifiedCandidate).c_str() : "", q.matches, q.inliers,
 					  1e3 * q.querySeconds, q.seenThroughRatio);

@@ -53,9 +53,9 @@ std::string effectiveConfigText(const std::string& path, const std::string& set)
 }
 
 /** OpenCV's own worker threads off for the lifetime of a run, restored afterwards. The run
- * already keeps both cores busy with its pipeline (decoding, extraction, tracking and mapping
+ * already keeps the cores busy with its pipeline (decoding, extraction, tracking and mapping
  * on their own threads); OpenCV parallelising the extraction on top of that preempts tracking
- * (fr1_rpy, 2026-11-25: 28.0-29.9 -> 32.5-34.1 fps sequential, doc/frontend.md "Modes"). */
+ * and lowers the frame rate (doc/frontend.md "Modes"). */
 class OpenCvThreadsOff
 {
    public:
@@ -82,8 +82,6 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	SlamConfig cfg = SlamConfig::FromConfig(ini, o.configPath);
 	if (o.modeOverride) cfg.mode = *o.modeOverride;
 	if (o.cameraOverride) cfg.camera = *o.cameraOverride;
-	if (cfg.mode != "sequential" && cfg.mode != "threaded")
-		throw std::invalid_argument("mode '" + cfg.mode + "' (expected sequential or threaded)");
 	{
 		// Parents too (--output runs/today/seq1); a file in the way is named.
 		std::error_code ec;
@@ -135,7 +133,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	SlamRunResult res;
 	const std::size_t total = o.maxFrames ? std::min(o.maxFrames, input.sizeHint().value_or(o.maxFrames)) : input.sizeHint().value_or(0);
 	core::ProgressBar bar("keygrid-slam", total, !o.quiet);
-	if (!o.quiet) std::cerr << "keygrid-slam: " << input.describe() << ", " << (live ? "live" : cfg.mode) << " mode\n";
+	if (!o.quiet) std::cerr << "keygrid-slam: " << input.describe() << ", " << (live ? "live" : toString(cfg.mode)) << " mode\n";
 	const auto tStart = Clock::now();
 	MemorySampler memory(25);  // report.json "rss_mb_by_keyframes"
 	auto report = [&](const sfm::TrackedFrame& tf) {
@@ -379,7 +377,7 @@ int SlamApp::run(int argc, const char* const* argv)
 		o.input = cl.get("input");
 		o.output = cl.get("output");
 		o.groundTruth = cl.has("gt") ? cl.get("gt") : "";
-		if (cl.has("mode")) o.modeOverride = cl.get("mode");
+		if (cl.has("mode")) o.modeOverride = runModeFromString(cl.get("mode"), "mode");
 		if (cl.has("camera")) o.cameraOverride = cl.get("camera");
 		if (cl.has("set"))
 		{

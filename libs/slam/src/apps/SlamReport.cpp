@@ -26,7 +26,7 @@ Json relocalizationEvents(const System& sys)
 {
 	Json events = Json::array();
 	for (const auto& f : sys.frames())
-		if (f.tracked && f.method == "relocalization")
+		if (f.tracked && f.method == sfm::TrackingMethod::Relocalization)
 			events.push_back({{"frame", f.index}, {"keyframe", f.relocalizationKeyFrame}, {"place_recognition", f.relocalizedByPlaceRecognition}});
 	return events;
 }
@@ -102,7 +102,7 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	js["input"] = in.input;
 	js["config"] = in.options.configPath;
 	js["config_set"] = in.options.set.empty() ? Json() : Json(in.options.set);
-	js["mode"] = cfg.mode;
+	js["mode"] = toString(cfg.mode);
 	js["frames"] = st.frames;
 	js["tracked"] = st.tracked;
 	js["lost"] = st.lost;
@@ -119,7 +119,7 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	js["landmarks"] = sys.map().numLandmarks();
 	js["landmarks_culled"] = st.landmarksCulled;
 	js["landmarks_fused"] = st.landmarksFused;
-	if (cfg.mode == "threaded") js["ba_discarded"] = st.baDiscarded;
+	if (cfg.mode == RunMode::Threaded) js["ba_discarded"] = st.baDiscarded;
 	if (cfg.tracker.hoc.enabled)
 		js["hoc"] = {{"landmarks_pruned", st.landmarksPrunedHoc}, {"increments", st.hocIncrements}, {"decrements", st.hocDecrements},
 					 {"occluded", st.hocOccluded},		{"recovered", st.hocRecovered},	   {"seen_through", st.hocSeenThrough},
@@ -136,7 +136,7 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	js["mean_ba_outliers"] = rounded(st.sumBaOutliers / kfs, 1);
 	js["mean_ba_iterations"] = rounded(st.sumBaIterations / kfs, 2);
 	if (const auto& ba = sys.globalBundleAdjustmentReport())
-		js["global_ba"] = {{"keyframes", ba->keyframes},		{"landmarks", ba->landmarks}, {"observations", ba->observations},
+		js["global_ba"] = {{"keyframes", ba->keyframes},		{"landmarks", ba->landmarks}, {"landmarks_left_out", ba->landmarksLeftOut}, {"observations", ba->observations},
 						   {"outliers", ba->outliersRemoved}, {"iterations", ba->iterations}, {"median_chi2", rounded(ba->medianChi2, 4)}};
 	js["fps"] = rounded(in.result.fps, 3);
 	js["wall_time_s"] = rounded(in.wallSeconds, 3);

@@ -3,8 +3,8 @@
  * descriptor matching and of the vocabulary tree.
  *
  * Debian builds for baseline x86-64, which has no POPCNT instruction: there
- * __builtin_popcountll becomes a call into libgcc (measured at 2.4 % of a whole keygrid-slam
- * run). Without -mpopcnt the bit count is done inline instead, by the classic parallel
+ * __builtin_popcountll becomes a call into libgcc, a visible share of a keygrid-slam run's
+ * time. Without -mpopcnt the bit count is done inline instead, by the classic parallel
  * ("SWAR") reduction: sums of 2, 4, 8 bits in place, then one multiply adds the 8 byte sums
  * into the top byte. */
 #include <cstdint>

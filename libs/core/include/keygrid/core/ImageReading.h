@@ -3,10 +3,9 @@
  * Image files in, as cv::imread reads them, with a faster path for the PNGs of RGB-D
  * datasets.
  *
- * Decoding the two PNGs of a TUM frame with cv::imread (libpng + zlib) takes about 9 ms, a
- * quarter of keygrid-slam's CPU time on fr1_rpy. PNG is a zlib stream of filtered rows: the
- * fast path reads the chunks itself, inflates the image data with libdeflate (about twice
- * zlib's speed) and undoes the row filters (PNG spec, section 9). It handles what RGB-D
+ * Decoding the two PNGs of a TUM frame with cv::imread (libpng + zlib) is a large share of
+ * keygrid-slam's CPU time. PNG is a zlib stream of filtered rows: the fast path reads the
+ * chunks itself, inflates the image data with libdeflate (faster than zlib) and undoes the row filters (PNG spec, section 9). It handles what RGB-D
  * datasets write: non-interlaced 8-bit grey / RGB / RGBA read as colour, and 8- or 16-bit
  * grey read as depth. Anything else (interlacing, palettes, other bit depths, other formats,
  * a checksum that does not match, a truncated file) goes to cv::imread, so results and

@@ -92,8 +92,7 @@ struct MorphingOptions
 	/** At most this many keyframes per corrected 8^3 block [count], 0 = no limit. Kept are those
 	 * with the largest (known source voxels their lookups can read in their travel window) x
 	 * (weight at the block centre), among those whose cone meets the block. An approximation
-	 * that trades F1 for time: on the corridor benchmark (doc/maps-3d.md) K = 16 cuts the
-	 * morphing CPU time by ~20 % but gives F1(b)/F1(c) 0.896 instead of 0.901.
+	 * that trades F1 for time (measured on the corridor benchmark, doc/maps-3d.md).
 	 * (INI morphMaxKeyframesPerBlock; serialized from version 2; Default: 0 = exact) */
 	unsigned maxKeyframesPerBlock{0};
 	/** Worker threads, 0 = all (Default: 0) */

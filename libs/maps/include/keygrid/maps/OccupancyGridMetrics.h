@@ -52,6 +52,12 @@ struct FloorPlanGrid
 	 * Free cell with SeenFreeSpace. Only the "seen" metrics use it. */
 	std::vector<uint8_t> seen;
 
+	/** A ground truth where every cell is scored: `occupied` (row-major, row 0 = lowest y,
+	 * non-zero = Occupied, else Free) on a sizeX x sizeY lattice whose cell (0, 0) has its corner
+	 * at (xMin, yMin), e.g. keygrid-sim's floor plan. Throws std::invalid_argument when the
+	 * sizes disagree. */
+	static FloorPlanGrid fromOccupancy(
+		double resolution, double xMin, double yMin, int sizeX, int sizeY, const std::vector<uint8_t>& occupied);
 	/** Ground truth at a floor-frame position; Ignore outside the lattice. */
 	Cell at(double x, double y) const;
 	Cell cell(int cx, int cy) const

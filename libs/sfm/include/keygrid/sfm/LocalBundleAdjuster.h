@@ -43,9 +43,8 @@ struct BundleAdjusterOptions
 	int iterations{10};
 	/** Stop earlier once an iteration lowers the cost by less than this fraction (Ceres'
 	 * function_tolerance; Default: 1e-6, Ceres' own). The local windows converge linearly
-	 * (robust loss) and mostly run all `iterations`; 1e-3 cuts the BA time by a third but moved
-	 * the fr1_rpy default run 2.04 -> 2.17 cm and room_loop's loop-closure gain below 3x, so it
-	 * stays an option (doc/frontend.md, "Local mapping cost"). */
+	 * (robust loss) and mostly run all `iterations`; a looser tolerance saves time at a cost in
+	 * accuracy (doc/frontend.md, "Local mapping cost"). */
 	double functionTolerance{1e-6};
 	/** Chi-square outlier thresholds after the solve (Default: 5.991 / 7.815) */
 	double chi2Mono{5.991}, chi2Rgbd{7.815};
@@ -61,6 +60,11 @@ struct BundleAdjusterOptions
 	/** Hand-written Jacobians (AnalyticReprojectionCost); false: Ceres autodiff of the
 	 * templated costs (Default: true) */
 	bool analyticJacobians{true};
+	/** A landmark that no keyframe measured the depth of takes part only if two of its
+	 * observing rays meet at this angle or more [deg]; otherwise it stays out of the problem
+	 * (its depth is unobservable, see BundleAdjusterReport::landmarksLeftOut). 0: every landmark
+	 * (Default: 0; the final global bundle adjustment uses [mapping] min_parallax_deg) */
+	double minParallaxDegWithoutDepth{0};
 	/** Linear solver, INI `linear_solver` = auto | dense_schur | sparse_schur |
 	 * iterative_schur (Default: auto) */
 	BaLinearSolver linearSolver{BaLinearSolver::Auto};
@@ -72,6 +76,9 @@ struct BundleAdjusterOptions
 struct BundleAdjusterReport
 {
 	int keyframes{0}, fixedKeyFrames{0}, landmarks{0}, observations{0}, outliersRemoved{0};
+	/** Landmarks seen by the moving keyframes but left out: no depth and too little parallax
+	 * (BundleAdjusterOptions::minParallaxDegWithoutDepth); they keep their position */
+	int landmarksLeftOut{0};
 	/** Levenberg-Marquardt iterations run (successful and rejected steps) */
 	int iterations{0};
 	double initialCost{0}, finalCost{0};
@@ -79,6 +86,8 @@ struct BundleAdjusterReport
 	 * (outliers included, so the outlier gate does not bias it): a self-consistency measure
 	 * of the camera model that needs no ground truth (2-3 for a consistent RGB-D model). */
 	double medianChi2{0};
+	/** Ceres' solve [s]: all of it, its residual and Jacobian evaluations, its linear solves */
+	double solverSeconds{0}, evaluationSeconds{0}, linearSolverSeconds{0};
 };
 
 /** One bundle adjustment in three steps, so that threaded mode can solve without holding the

@@ -67,8 +67,8 @@ double inlierThreshold(const PoseObservation& ob, const PoseOptimizerOptions& op
  * A person walking past the camera is matched frame after frame by projection search, so its
  * landmarks pass every per-frame outlier test; when the static points are far and shallow
  * (one depth layer) they cannot tell a sideways translation t from a rotation t / depth, and
- * the walker's points decide the pose, which then drifts with the walker (keygrid-sim
- * moving_camera_dynamic: 256 mm ATE). The walker's landmarks are young: each new keyframe
+ * the walker's points decide the pose, which then drifts with the walker (keygrid-sim's
+ * moving_camera_dynamic scene). The walker's landmarks are young: each new keyframe
  * re-creates them. Landmarks seen by several keyframes are what the map has confirmed.
  *
  * So: (1) refine the pose from the anchors alone (isAnchor[i]); (2) drop the other

@@ -26,6 +26,18 @@ enum class TrackingState
 	Lost
 };
 
+/** How the pose of a frame was found. */
+enum class TrackingMethod
+{
+	Init,  //!< the frame started a map (first keyframe)
+	Prediction,  //!< search around the motion model's prediction, then the local map
+	Pnp,  //!< PnP-RANSAC on the reference keyframe's landmarks, then the local map
+	Relocalization,  //!< after a loss: place recognition / newest keyframes, then the local map
+	Lost  //!< not tracked
+};
+/** "init", "prediction", "pnp", "relocalization" or "lost" (frames.csv "method"). */
+const char* toString(TrackingMethod m);
+
 /** One inlier observation of a tracked frame, kept for the re-estimation of its pose against the
  * final map (the landmark's position is read from the map then). A run keeps one list per frame,
  * so it is stored compactly; the values are exactly those of the PoseObservation it stands for
@@ -54,8 +66,7 @@ struct TrackedFrame
 	double timestamp{0};
 	mrpt::poses::CPose3D T_world_cam;
 	bool tracked{false};
-	/** "init", "prediction", "pnp", "relocalization" or "lost" */
-	std::string method;
+	TrackingMethod method{TrackingMethod::Lost};
 	int matches{0}, inliers{0};
 	bool newKeyFrame{false};
 	KeyFrameId keyframe{0};  //!< the new keyframe when newKeyFrame
@@ -70,7 +81,7 @@ struct TrackedFrame
 	HocUpdateStats hoc;
 	double hocSeconds{0};  //!< thread CPU time of HOC selection and update [s]
 	bool hocFallback{false};  //!< tracked only with the HOC fallback selection (Tracker::track)
-	/** When method is "relocalization" and the frame was tracked: the keyframe it was found
+	/** When method is Relocalization and the frame was tracked: the keyframe it was found
 	 * on, and whether place recognition (rather than the newest keyframes) proposed it. */
 	KeyFrameId relocalizationKeyFrame{0};
 	bool relocalizedByPlaceRecognition{false};

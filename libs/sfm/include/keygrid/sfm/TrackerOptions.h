@@ -38,15 +38,13 @@ struct TrackerOptions
 	 * first when relocalizing; 0 = newest keyframes only (Default: 10) */
 	int relocalizationBowCandidates{10};
 	/** A relocalization holds only when the local-map search matches at least this share of
-	 * the local map's landmarks in view (Default: 0.25; a true revisit matched 36 % in the
-	 * kidnapped room_loop test, look-alike places 2 m away on the 2 m periodic
-	 * texture of the synthetic walls 12-16 %) */
+	 * the local map's landmarks in view: a true revisit matches a good share of them, a
+	 * look-alike place (periodic texture) only a few (Default: 0.25) */
 	double relocalizationMinInlierRatio{0.25};
 	/** Adapts that share to the features and the data: the required share is
 	 * min(relocalization_min_inlier_ratio, this x the median share matched by the last 30
-	 * tracked frames). Normal tracking matches a median 42-46 % on the synthetic scenes (the
-	 * fixed 0.25 holds), 24 % with ORB and 20 % with SIFT on fr1_rpy, where a true place at
-	 * 15-20 % was refused and SIFT stayed lost for 139 frames. 0 = the fixed share
+	 * tracked frames): where even normal tracking matches a small share (real sequences, SIFT),
+	 * a true place matching less than the fixed share is still accepted. 0 = the fixed share
 	 * (Default: 0.6) */
 	double relocalizationShareFactor{0.6};
 
@@ -55,8 +53,8 @@ struct TrackerOptions
 	/** Insert when tracked landmarks fall below this fraction of the reference keyframe's (Default: 0.5) */
 	double keyFrameTrackedRatio{0.5};
 	/** Reference-keyframe landmarks counted by that ratio: those seen by at least this many
-	 * keyframes (Default: 1, all of them. ORB-SLAM2's RGB-D rule, 2 with ratio 0.75, gave
-	 * fewer keyframes and 2-3x the error on the synthetic room loops: doc/evaluation-history.md) */
+	 * keyframes (Default: 1, all of them. ORB-SLAM2's RGB-D rule, 2 with ratio 0.75, makes
+	 * fewer keyframes and larger errors: doc/evaluation-history.md) */
 	int keyFrameRefMinObservations{1};
 	/** Depth under which points count as "close" (well-measured) [m] (Default: 3.0) */
 	double closeDepth{3.0};
@@ -76,17 +74,16 @@ struct TrackerOptions
 	/** Anchored pose refinement against moving objects (optimizePoseAnchored, PoseOptimizer.h):
 	 * the final refinement of each frame is solved first from the landmarks seen by at least
 	 * this many keyframes, and matches of younger landmarks whose chi-square there exceeds
-	 * anchor_chi2_factor x the inlier threshold are dropped. 0 = off (Default: 3; people
-	 * walking past a moving camera, keygrid-sim moving_camera_dynamic: 256 -> 17 mm ATE, fr1_rpy
-	 * +1 %, doc/evaluation.md) */
+	 * anchor_chi2_factor x the inlier threshold are dropped, so that people walking past a
+	 * moving camera do not drag it along (doc/evaluation.md). 0 = off (Default: 3) */
 	int anchorMinKeyFrames{3};
 	/** Rejection threshold of that test, a multiple of the chi-square inlier threshold
 	 * (Default: 9, i.e. 3x the residual) */
 	double anchorChi2Factor{9.0};
 	/** Anchored refinement only with at least this many anchors matched; fewer (fast turns
-	 * into new parts of the scene) leave the plain refinement. 30 gave the same moving-camera
-	 * gain, but fr1_rpy with pasted moving objects went 20 -> 50 mm, where a few anchors on
-	 * an object that had stood still outvoted the young static points (Default: 100) */
+	 * into new parts of the scene) leave the plain refinement. High enough that a few anchors
+	 * on an object that stood still and then moves cannot outvote the young static points
+	 * (Default: 100) */
 	int anchorMinCount{100};
 	MatcherOptions matcher;
 	PoseOptimizerOptions pose;

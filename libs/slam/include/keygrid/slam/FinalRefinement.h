@@ -7,10 +7,12 @@
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/slam/LoopCloser.h>
+#include <keygrid/slam/SlamConfig.h>
 
 #include <functional>
 #include <map>
 #include <optional>
+#include <set>
 #include <vector>
 
 namespace keygrid::slam
@@ -19,6 +21,22 @@ namespace keygrid::slam
  * closed loop, the newest loop first (there the pose graph bent the trajectory and landmarks
  * were fused), then the newest keyframe (refined by the fewest local windows). */
 std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<LoopClosureEvent>& loops, const sfm::SparseMap& map);
+
+struct FinalBundleAdjustment
+{
+	sfm::BundleAdjusterReport report;
+	/** The keyframes it moved when bounded; nullopt when it moved every keyframe */
+	std::optional<std::set<sfm::KeyFrameId>> window;
+};
+
+/** The final bundle adjustment of a run, in place: every keyframe and landmark (the first
+ * keyframe fixed), or in a map of more than rc.globalMaxKeyFrames keyframes the window grown
+ * from finalWindowSeeds(). The local windows' options `mapping.ba`, with rc.globalIterations
+ * and Ceres' default tolerance (it runs once, to convergence); a landmark without a depth
+ * measurement whose rays meet at less than mapping.minParallaxDeg stays out. */
+FinalBundleAdjustment finalBundleAdjustment(
+	sfm::SparseMap& map, const sfm::PinholeIntrinsics& K, const std::vector<LoopClosureEvent>& loops,
+	const RefinementOptions& rc, const sfm::LocalMapperOptions& mapping);
 
 /** Largest displacement [m], over the keyframes of `before` that are in `after`, of the camera
  * centre or of the point `depth` m ahead of it on the optical axis (what a rotation moves in

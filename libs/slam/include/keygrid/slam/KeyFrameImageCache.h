@@ -1,6 +1,6 @@
 #pragma once
 /** \file KeyFrameImageCache.h
- * Keeps keyframe images out of RAM (issue 25, bounded memory). Once a keyframe has been
+ * Keeps keyframe images out of RAM, so that a run's memory stays bounded. Once a keyframe has been
  * inserted into the metric maps and handed to the session recorder, System moves its images
  * here (put) and the keyframe drops them; whoever needs them later (dense 2D input waiting for
  * the floor, keyframes.simplemap) loads them through the cache.

@@ -32,14 +32,17 @@ struct LoopClosingOptions
 	std::string vocabulary{"default"};
 	/** Keyframes whose descriptors train the vocabulary when no file is given (Default: 10) */
 	int trainKeyFrames{10};
-	/** Tree shape used for that training (Default: branching 10, 3 levels = 1000 words) */
-	loop::VocabularyOptions vocabularyOptions{10, 3, 10, 1, 1};
+	/** Tree shape used for that training (Default: branching 10, 3 levels = 1000 words,
+	 * 10 k-means iterations, seed 1, one thread; trainingVocabularyDefaults()) */
+	loop::VocabularyOptions vocabularyOptions{trainingVocabularyDefaults()};
 	/** Candidates must be at least this many keyframes older than the query (Default: 15) */
 	int minKeyFrameGap{15};
 	/** Consecutive keyframes that must agree on a candidate group (Default: 3) */
 	int consistency{3};
-	/** Geometric verification: RANSAC on matched keypoints with depth */
-	loop::RigidRansacOptions ransac{0.04, 40, 300, 0.999, 5, false, 42};
+	/** Geometric verification: RANSAC on matched keypoints with depth (Default: inliers within
+	 * 0.04 m, 40 of them, at most 300 hypotheses, confidence 0.999, 5 refinement rounds, rigid,
+	 * seed 42; verificationRansacDefaults()) */
+	loop::RigidRansacOptions ransac{verificationRansacDefaults()};
 	/** Plausibility: the loop may move the current keyframe (relative to the loop keyframe) by
 	 * at most max_correction_base + max_correction_ratio x the path travelled between them
 	 * [m], and rotate it by at most max_correction_deg. Drift is a small fraction of the path;
@@ -59,6 +62,13 @@ struct LoopClosingOptions
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+
+	/** The default of vocabularyOptions: a tree small enough for the few keyframes that train
+	 * it in the run (train_keyframes). */
+	static loop::VocabularyOptions trainingVocabularyDefaults();
+	/** The default of ransac: stricter than RigidRansacOptions' (more inliers, a tighter
+	 * distance), as a wrong loop bends the whole map. */
+	static loop::RigidRansacOptions verificationRansacDefaults();
 };
 
 /** One closed loop, with the pose change of every keyframe (for the maps). */
@@ -82,20 +92,33 @@ struct LoopClosureEvent
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> newPoses;
 };
 
+/** Whether loop detection closed a loop at a keyframe, or why not. */
+enum class LoopQueryOutcome
+{
+	Closed,
+	NoVocabulary,  //!< in-run training not done yet
+	AfterLoop,  //!< detection paused right after a loop
+	NoCandidate,  //!< nothing above the covisible keyframes' score
+	NotConsistent,  //!< no candidate group seen in enough consecutive keyframes
+	FewMatches,  //!< geometric verification: too few matches with depth
+	RansacFailed,  //!< geometric verification: too few RANSAC inliers
+	Implausible,  //!< correction larger than drift explains
+	MergePending,  //!< a loop between two maps waiting for more that agree (mergeConsistency)
+	MergeSeenThrough,  //!< a loop between two maps that puts landmarks where a keyframe sees free space
+	PoseGraphFailed
+};
+/** "closed", "no_vocabulary", "after_loop", "no_candidate", "not_consistent", "few_matches",
+ * "ransac_failed", "implausible", "merge_pending", "merge_seen_through" or "pose_graph_failed"
+ * (loop_queries.csv "outcome"). */
+const char* toString(LoopQueryOutcome o);
+
 /** What loop detection made of one keyframe (keygrid-slam writes them to loop_queries.csv):
  * why a loop was or was not closed there. */
 struct LoopQueryRecord
 {
 	sfm::KeyFrameId keyframe{0};
 	std::size_t frameIndex{0};
-	/** "closed", or why not: "no_vocabulary" (in-run training not done yet), "after_loop"
-	 * (detection paused right after a loop), "no_candidate" (nothing above the covisible
-	 * keyframes' score), "not_consistent" (no candidate group seen in enough consecutive
-	 * keyframes), "few_matches" / "ransac_failed" (geometric verification), "implausible"
-	 * (correction larger than drift explains), "merge_pending" (a loop between two maps waiting
-	 * for more that agree, see mergeConsistency), "merge_seen_through" (a loop between two
-	 * maps that puts landmarks where a keyframe sees free space), "pose_graph_failed" */
-	std::string outcome;
+	LoopQueryOutcome outcome{LoopQueryOutcome::NoCandidate};
 	/** The lowest BoW score between the keyframe and its covisible keyframes */
 	double referenceScore{0};
 	int candidates{0};  //!< database candidates above that reference
@@ -143,6 +166,9 @@ class LoopCloser
 	const loop::Vocabulary& vocabulary() const { return m_vocab; }
 	/** One record per keyframe handled by process(), in order. */
 	const std::vector<LoopQueryRecord>& queries() const { return m_queries; }
+	/** Loops that passed verification but were rejected as implausible (the queries with
+	 * outcome Implausible; diagnostics). */
+	int rejectedImplausible() const;
 	/** The keyframe pose graph of the last correction (for posegraph.g2o). */
 	const std::optional<loop::PoseGraph>& lastPoseGraph() const { return m_lastGraph; }
 
@@ -152,7 +178,7 @@ class LoopCloser
 	std::optional<sfm::KeyFrameId> detect(sfm::KeyFrameId kf, const loop::BowVector& bow, double& score, LoopQueryRecord& rec);
 	/** True for a loop inside one map; for one between two maps (a merge), true once
 	 * mergeConsistency verified loops in a row agree on where the current map lies (else
-	 * rec.outcome = "merge_pending"). */
+	 * rec.outcome = MergePending). */
 	bool mergeConfirmed(
 		sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec);
 	/** False when the loop measurement disagrees with the estimate more than drift can explain. */
@@ -186,10 +212,6 @@ class LoopCloser
 	sfm::KeyFrameId m_lastLoopKf{0};
 	bool m_anyLoop{false};
 	std::vector<LoopQueryRecord> m_queries;
-
-   public:
-	/** Loops that passed verification but were rejected as implausible (diagnostics). */
-	int rejectedImplausible{0};
 };
 
 /** CPose3D <-> Eigen isometry. */

@@ -25,10 +25,9 @@ struct RefinementOptions
 	/** Bundle-adjust all keyframes and landmarks at the end (Default: true) */
 	bool globalBundleAdjustment{true};
 	/** Upper bound on the Levenberg-Marquardt iterations of the final global bundle adjustment,
-	 * which otherwise stops when an iteration lowers the cost by less than 1e-6 (Default: 100).
-	 * The synthetic room and corridor loops converge in 2-9 iterations, fr1_rpy in 6-52; the 44 m
-	 * office_loop needs 46-47, and the former bound of 20 left its loop-closed trajectory at
-	 * 1.44 instead of 1.11 cm (doc/evaluation.md, "Batch"). */
+	 * which otherwise stops when an iteration lowers the cost by less than 1e-6. A safety
+	 * bound, set above what a long loop needs to converge: stopping earlier leaves part of
+	 * the loop correction undone (iteration counts in doc/evaluation.md) (Default: 100) */
 	int globalIterations{100};
 	/** Bound of the final bundle adjustment's cost: in a map with more keyframes than this,
 	 * it moves only this many, grown through the covisibility graph from both ends of every
@@ -36,9 +35,8 @@ struct RefinementOptions
 	 * that also see their landmarks hold them in place, and only the frames whose reference
 	 * keyframe moved are re-estimated. The rest of the map keeps what local bundle
 	 * adjustments and the loops' pose graphs made of it, which is less accurate on a long loop
-	 * than one adjustment of every keyframe (doc/evaluation.md, "Memory and final step on a
-	 * long run"). 0: every keyframe and frame, at a cost that grows faster than the map
-	 * (Default: 0) */
+	 * than one adjustment of every keyframe (doc/evaluation.md). 0: every keyframe and frame, at
+	 * a cost that grows faster than the map (Default: 0) */
 	int globalMaxKeyFrames{0};
 	/** Re-estimate the frames' poses against the refined map: every frame after a global
 	 * bundle adjustment of every keyframe, the frames whose reference keyframe it moved after a
@@ -53,10 +51,23 @@ struct RefinementOptions
 	double mapReanchorDepth{4.0};
 };
 
+/** How the stages of a run share the machine. */
+enum class RunMode
+{
+	Sequential,  //!< one stage after the other: deterministic, the default for files
+	Threaded  //!< tracking, local mapping and loop closing on their own threads (pipelined)
+};
+/** "sequential" or "threaded": [slam] mode, keygrid-slam --mode, report.json "mode". */
+const char* toString(RunMode m);
+/** The inverse of toString(RunMode); throws std::invalid_argument
+ * "<what> '<text>' (expected sequential or threaded)" for any other text. */
+RunMode runModeFromString(const std::string& text, const std::string& what);
+
 struct SlamConfig
 {
-	/** "sequential" (deterministic, default for files) or "threaded" (pipelined stages) */
-	std::string mode{"sequential"};
+	/** Sequential (deterministic, default for files) or threaded (pipelined stages)
+	 * (Default: sequential) */
+	RunMode mode{RunMode::Sequential};
 	/** Camera for TUM folders: preset name or INI path; "auto" (or empty) = camera.ini in the
 	 * folder, else guessed from the folder name (Default: auto) */
 	std::string camera{"auto"};
@@ -65,16 +76,16 @@ struct SlamConfig
 	 * bundle-adjusted) before the next frame, so it sees the map sequential mode sees (the
 	 * same trajectory byte for byte without loop closures); tracking and local mapping then
 	 * take turns. 1: local mapping works on a keyframe while tracking goes on, and
-	 * busy_keyframe_ratio keeps tracking from queueing more keyframes meanwhile: on fr1_rpy
-	 * 1.25x the frame rate of 0 at 1.44-1.80 cm instead of 1.49 (doc/frontend.md "Modes").
-	 * At most 5 (the queue holds 4 waiting keyframes). (Default: 1) */
+	 * busy_keyframe_ratio keeps tracking from queueing more keyframes meanwhile: a higher
+	 * frame rate than 0 at about the same accuracy (doc/frontend.md "Modes"). At most 5 (the
+	 * queue holds 4 waiting keyframes). (Default: 1) */
 	int mappingLag{1};
 	/** Threaded mode with mapping_lag > 0: while local mapping is still working on a keyframe,
 	 * tracking inserts a new one only at the keyframe timeout or when it tracks fewer than this
 	 * share of the reference keyframe's landmarks (ORB-SLAM2's rule, which uses 0.25); the
-	 * frames in between are tracked against the map being refined. fr1_rpy, 5 runs each:
-	 * 0.25: 75-80 fps, 1.51-1.90 cm; 0.35: 64-72 fps, 1.32-1.73 cm; 0.5: 50-56 fps,
-	 * 1.34-1.45 cm. 0 = insert whenever tracking asks, busy or not. (Default: 0.35) */
+	 * frames in between are tracked against the map being refined. Lower: fewer keyframes,
+	 * faster and less accurate; higher: the reverse (doc/frontend.md "Modes"). 0 = insert
+	 * whenever tracking asks, busy or not. (Default: 0.35) */
 	double busyKeyFrameRatio{0.35};
 	sfm::FeatureOptions features;
 	sfm::TrackerOptions tracker;
@@ -87,7 +98,6 @@ struct SlamConfig
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;
-	/** Reads an INI file; throws std::invalid_argument naming the file and the bad key. */
 	/** Throws std::invalid_argument naming the first key of a SlamConfig section ([slam],
 	 * [tracker], [hoc], ...) that no option reads. */
 	static void checkKnownKeys(const mrpt::config::CConfigFileBase& cfg);

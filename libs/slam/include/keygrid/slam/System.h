@@ -63,7 +63,7 @@ class System
 	 * there is one (map outputs of an exported session are written in it). */
 	static constexpr const char* kFloorAttribute = "run.T_world_floor";
 
-	/** Starts the mapping and loop-closing threads when cfg.mode is "threaded". */
+	/** Starts the mapping and loop-closing threads when cfg.mode is RunMode::Threaded. */
 	explicit System(const SlamConfig& cfg);
 	/** Stops and joins the threads (what they had queued is still processed). */
 	~System();

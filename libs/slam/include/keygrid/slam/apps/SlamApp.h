@@ -14,7 +14,8 @@ namespace keygrid::slam
 struct SlamRunOptions
 {
 	std::string configPath, input, output, groundTruth;
-	std::optional<std::string> modeOverride, cameraOverride;
+	std::optional<RunMode> modeOverride;
+	std::optional<std::string> cameraOverride;
 	/** `section.key=value; ...` applied to an in-memory copy of the configuration file
 	 * (keygrid-slam --set); every key must exist in the file or in keygrid-slam's options. */
 	std::string set;

@@ -1,0 +1,78 @@
+/** \file EnumNames_unittest.cpp
+ * The words keygrid-slam writes for its enums (frames.csv "method", loop_queries.csv
+ * "outcome", report.json "mode") and reads back ([slam] mode, --mode): scripts and old
+ * outputs depend on them, so they are pinned here.
+ */
+#include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/LoopCloser.h>
+#include <keygrid/slam/SlamConfig.h>
+#include <mrpt/config/CConfigFileMemory.h>
+
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+#include <string>
+
+using namespace keygrid;
+
+TEST(EnumNames, TrackingMethodsAreTheWordsOfFramesCsv)
+{
+	using sfm::TrackingMethod;
+	EXPECT_STREQ(sfm::toString(TrackingMethod::Init), "init");
+	EXPECT_STREQ(sfm::toString(TrackingMethod::Prediction), "prediction");
+	EXPECT_STREQ(sfm::toString(TrackingMethod::Pnp), "pnp");
+	EXPECT_STREQ(sfm::toString(TrackingMethod::Relocalization), "relocalization");
+	EXPECT_STREQ(sfm::toString(TrackingMethod::Lost), "lost");
+}
+
+TEST(EnumNames, LoopQueryOutcomesAreTheWordsOfLoopQueriesCsv)
+{
+	using slam::LoopQueryOutcome;
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::Closed), "closed");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::NoVocabulary), "no_vocabulary");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::AfterLoop), "after_loop");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::NoCandidate), "no_candidate");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::NotConsistent), "not_consistent");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::FewMatches), "few_matches");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::RansacFailed), "ransac_failed");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::Implausible), "implausible");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::MergePending), "merge_pending");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::MergeSeenThrough), "merge_seen_through");
+	EXPECT_STREQ(slam::toString(LoopQueryOutcome::PoseGraphFailed), "pose_graph_failed");
+}
+
+TEST(EnumNames, RunModeIsReadAndWrittenAsSequentialOrThreaded)
+{
+	using slam::RunMode;
+	for (const RunMode m : {RunMode::Sequential, RunMode::Threaded})
+		EXPECT_EQ(slam::runModeFromString(slam::toString(m), "mode"), m) << slam::toString(m);
+	EXPECT_STREQ(slam::toString(RunMode::Sequential), "sequential");
+	EXPECT_STREQ(slam::toString(RunMode::Threaded), "threaded");
+	EXPECT_EQ(slam::SlamConfig().mode, RunMode::Sequential);
+
+	mrpt::config::CConfigFileMemory threaded("[slam]\nmode = threaded\n");
+	slam::SlamConfig cfg;
+	cfg.loadFromConfigFile(threaded);
+	EXPECT_EQ(cfg.mode, RunMode::Threaded);
+	mrpt::config::CConfigFileMemory written;
+	cfg.saveToConfigFile(written);
+	const mrpt::config::CConfigFileMemory reread(written.getContent());
+	EXPECT_EQ(reread.read_string("slam", "mode", ""), "threaded") << written.getContent();
+
+	// Exact words only; the error names the key and the value.
+	for (const char* bad : {"Threaded", "parallel"})
+	{
+		mrpt::config::CConfigFileMemory ini(std::string("[slam]\nmode = ") + bad + "\n");
+		try
+		{
+			slam::SlamConfig c;
+			c.loadFromConfigFile(ini);
+			ADD_FAILURE() << "accepted mode '" << bad << "'";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_EQ(std::string(e.what()), std::string("[slam] mode = '") + bad + "' (expected sequential or threaded)");
+		}
+	}
+	EXPECT_THROW(slam::runModeFromString("threaded ", "mode"), std::invalid_argument);
+}
