@@ -1,11 +1,12 @@
 // The final global bundle adjustment on a stored map, timed and scored against ground truth.
 //
 // Record a run without its final step, then adjust the stored map as keygrid-slam's final step
-// would, with the [refinement] / [local_mapping] options of an INI (plus --set overrides):
+// would, with the [refinement] / [mapping] options of an INI (plus --set overrides, checked as
+// keygrid-slam checks them):
 //
-//   keygrid-slam --config config/sim.ini --input SIM/tum --output OUT --map map.kgmap \
+//   keygrid-slam --config config/sim.ini --input SIM/tum --output OUT --map map.kgmap
 //       --set 'refinement.global_bundle_adjustment=false; refinement.refine_frames=false'
-//   keygrid_global_ba_bench --session map.kgmap --config config/sim.ini --gt SIM/groundtruth.txt \
+//   keygrid_global_ba_bench --session map.kgmap --config config/sim.ini --gt SIM/groundtruth.txt
 //       [--set 'refinement.global_iterations=10'] [--repeat N]
 //
 // Prints one line per repetition: the problem's size, Ceres' time split (residuals and Jacobians,
@@ -18,14 +19,12 @@
 #include <keygrid/slam/FinalRefinement.h>
 #include <keygrid/slam/SessionLoader.h>
 #include <keygrid/slam/SlamConfig.h>
-#include <keygrid/slam/apps/BatchExperiment.h>
+#include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/config/CConfigFileMemory.h>
 
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 
 using namespace keygrid;
 
@@ -36,15 +35,6 @@ core::Trajectory keyframeTrajectory(const sfm::SparseMap& map)
 	core::Trajectory out;
 	for (const auto& [id, kf] : map.keyframes()) out.push_back({kf.timestamp, kf.T_world_cam});
 	return out;
-}
-
-std::string readText(const std::string& path)
-{
-	std::ifstream f(path);
-	if (!f) throw std::runtime_error("cannot read '" + path + "'");
-	std::stringstream ss;
-	ss << f.rdbuf();
-	return ss.str();
 }
 }  // namespace
 
@@ -59,8 +49,7 @@ int main(int argc, char** argv)
 			.option("set", "SECTION.KEY=V[;...]", "overrides, as keygrid-slam --set")
 			.option("repeat", "N", "repetitions, each on a fresh copy of the map", false, "1");
 		if (!cl.parse(argc, argv)) return 0;
-		std::string text = readText(cl.get("config"));
-		if (cl.has("set")) text = slam::applyOverrides(text, slam::parseOverrides(cl.get("set"), "--set"));
+		const std::string text = slam::effectiveConfigText(cl.get("config"), cl.has("set") ? cl.get("set") : "");
 		const auto cfg = slam::SlamConfig::FromConfig(mrpt::config::CConfigFileMemory(text), cl.get("config"));
 		const auto gt = core::readTumTrajectory(cl.get("gt"));
 		const auto session = store::SessionStore::Open(cl.get("session"));

@@ -38,20 +38,6 @@ namespace
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-/** The configuration file's text with `set` applied (keys checked first: MRPT would ignore a
- * misspelt one). The file is read once, so every reader sees the same configuration. */
-std::string effectiveConfigText(const std::string& path, const std::string& set)
-{
-	if (!mrpt::system::fileExists(path)) throw std::invalid_argument("config file '" + path + "' does not exist");
-	if (std::filesystem::is_directory(path)) throw std::invalid_argument("config file '" + path + "' is a folder, not a file");
-	std::string text = mrpt::io::file_get_contents(path);
-	core::checkIniText(text, path);
-	if (set.empty()) return text;
-	const auto overrides = parseOverrides(set, "--set");
-	checkOverrideKeys(text, overrides, "--set");
-	return applyOverrides(text, overrides);
-}
-
 /** OpenCV's own worker threads off for the lifetime of a run, restored afterwards. The run
  * already keeps the cores busy with its pipeline (decoding, extraction, tracking and mapping
  * on their own threads); OpenCV parallelising the extraction on top of that preempts tracking
@@ -75,6 +61,18 @@ struct Extracted
 	double loadSeconds{0}, extractSeconds{0};
 };
 }  // namespace
+
+std::string effectiveConfigText(const std::string& path, const std::string& set)
+{
+	if (!mrpt::system::fileExists(path)) throw std::invalid_argument("config file '" + path + "' does not exist");
+	if (std::filesystem::is_directory(path)) throw std::invalid_argument("config file '" + path + "' is a folder, not a file");
+	std::string text = mrpt::io::file_get_contents(path);
+	core::checkIniText(text, path);
+	if (set.empty()) return text;
+	const auto overrides = parseOverrides(set, "--set");
+	checkOverrideKeys(text, overrides, "--set");
+	return applyOverrides(text, overrides);
+}
 
 SlamRunResult runSlam(const SlamRunOptions& o)
 {

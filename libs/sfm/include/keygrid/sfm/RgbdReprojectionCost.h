@@ -18,9 +18,9 @@
  * pyramid levels are less precisely located); the depth residual is not: the measured depth
  * does not depend on the level the keypoint was detected at. (ORB-SLAM2's virtual right
  * coordinate u_obs - bf / d_obs, divided by sigma_level, re-counts the u error and weights
- * the depth of a level-7 keypoint 3.6x less; with bf = 40 its 1-sigma depth error at 1.65 m
- * is then 6.8 cm, ~18x the sensor noise, which leaves the pose free along the
- * rotation/translation ambiguity of narrow-field reprojection.) The caller adds the robust (Huber) loss.
+ * the depth of a coarse-level keypoint far less than the sensor's noise warrants, which leaves
+ * the pose free along the rotation/translation ambiguity of narrow-field reprojection.) The
+ * caller adds the robust (Huber) loss.
  */
 #include <Eigen/Core>
 #include <Eigen/Geometry>

@@ -57,6 +57,11 @@ struct SlamRunResult
 	std::string lastSkip;
 };
 
+/** The text of configuration file `path` with the `--set` overrides `set` applied (their keys
+ * checked first: MRPT would ignore a misspelt one); every reader of one run sees this text.
+ * Throws std::invalid_argument naming the file or the bad override. */
+std::string effectiveConfigText(const std::string& path, const std::string& set);
+
 /** Runs one sequence end to end; throws on bad configuration or unopenable input. */
 SlamRunResult runSlam(const SlamRunOptions& opts);
 
