@@ -19,6 +19,7 @@ CISMOccupancyGrid2D::TMapDefinition::TMapDefinition() = default;
 void CISMOccupancyGrid2D::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
 {
+	optionSection = sectionNamePrefix;
 	creationOpts.loadFromConfigFile(source, sectionNamePrefix + "_creationOpts");
 	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
 	likelihoodOpts.loadFromConfigFile(source, sectionNamePrefix + "_likelihoodOpts");
@@ -38,6 +39,7 @@ mrpt::maps::CMetricMap* CISMOccupancyGrid2D::internal_CreateFromMapDefinition(
 	auto* obj = new CISMOccupancyGrid2D(def.creationOpts);
 	obj->insertionOptions = def.insertionOpts;
 	obj->likelihoodOptions = def.likelihoodOpts;
+	obj->m_optionSection = def.optionSection;
 	return obj;
 }
 //  =========== End of Map definition Block =========
@@ -96,6 +98,7 @@ void CISMOccupancyGrid2D::internal_clear()
 {
 	resetGeometry(creationOptions);
 	m_keyframes.clear();
+	m_waitingForFloor.clear();
 	m_floorEstimated = false;
 	m_T_world_floorEstimate = mrpt::poses::CPose3D();
 	m_lastRebuildSeconds = 0;

@@ -1,7 +1,7 @@
 #include <keygrid/sfm/PoseOptimizer.h>
 #include <mrpt/math/CMatrixFixed.h>
 
-#include <ceres/ceres.h>
+#include <keygrid/sfm/PoseLevenbergMarquardt.h>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -12,23 +12,6 @@ namespace keygrid::sfm
 {
 namespace
 {
-/** Pose-only form of AnalyticReprojectionCost (hand-written Jacobians, see
- * RgbdReprojectionCost.h): the point is a constant. Parameters q_cam_world (x,y,z,w) and
- * t_cam_world; 3 residuals, the third one 0 without depth. */
-class AnalyticPoseCost final : public ceres::SizedCostFunction<3, 4, 3>
-{
-   public:
-	AnalyticPoseCost(const AnalyticReprojectionCost& c, const Eigen::Vector3d& p_world) : m_cost(c), m_p(p_world) {}
-	bool Evaluate(double const* const* x, double* r, double** J) const override
-	{
-		return m_cost.evaluate(x[0], x[1], m_p.data(), r, J ? J[0] : nullptr, J ? J[1] : nullptr, nullptr);
-	}
-
-   private:
-	AnalyticReprojectionCost m_cost;
-	Eigen::Vector3d m_p;
-};
-
 // chi2 of an observation whose point is not in front of the camera (never an inlier).
 constexpr double kBehindCamera = 1e30;
 
@@ -131,54 +114,57 @@ PoseOptimizerResult optimizePose(
 {
 	if (obs.empty()) throw std::invalid_argument("optimizePose: no observations");
 	if (!(o.disparitySigma > 0)) throw std::invalid_argument("optimizePose: disparitySigma must be > 0");
-	double q[4], t[3];
-	toCeres(T_world_cam, q, t);
+	double q[4], tq[3];
+	toCeres(T_world_cam, q, tq);
+	Eigen::Matrix3d R = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+	Eigen::Vector3d t(tq[0], tq[1], tq[2]);
 	const std::size_t n = obs.size();
+
+	// Each observation as a residual term (AnalyticReprojectionCost's model); the Huber
+	// threshold is set per round.
+	std::vector<PoseResidualTerm> all(n);
+	for (std::size_t i = 0; i < n; i++)
+	{
+		auto& term = all[i];
+		term.p_world = obs[i].p_world;
+		term.uv = obs[i].uv;
+		term.invSigma = obs[i].invSigma;
+		if (usesDepth(obs[i], o))
+		{
+			term.disparity = o.bf / obs[i].depth;
+			term.invSigmaDisparity = 1.0 / o.disparitySigma;
+		}
+	}
+	const auto chi2 = [&](std::size_t i)
+	{
+		double e;
+		return poseResidualSquaredNorm(R, t, all[i], K, o.bf, e) ? e : kBehindCamera;
+	};
+
 	PoseOptimizerResult res;
 	res.inlier.assign(n, 1);
-
-	auto useDepth = [&](const PoseObservation& ob) { return usesDepth(ob, o); };
-	auto chi2 = [&](const PoseObservation& ob) { return chi2At(q, t, ob, K, o); };
-
-	// A point behind the camera at the initial pose would make Ceres stop at its first
+	// A point behind the camera at the initial pose would stop the solve at its first
 	// evaluation: such observations start as outliers (they may come back after a round).
-	for (std::size_t i = 0; i < n; i++) res.inlier[i] = chi2(obs[i]) < kBehindCamera;
+	for (std::size_t i = 0; i < n; i++) res.inlier[i] = chi2(i) < kBehindCamera;
 
-	ceres::Solver::Options so;
-	so.linear_solver_type = ceres::DENSE_QR;
-	so.max_num_iterations = o.iterationsPerRound;
-	so.num_threads = 1;
-	so.logging_type = ceres::SILENT;
-	so.minimizer_progress_to_stdout = false;
-
-	// One Huber loss per observation kind, shared by all residual blocks of a round.
-	ceres::HuberLoss huberRgbd(std::sqrt(o.chi2Rgbd)), huberMono(std::sqrt(o.chi2Mono));
+	PoseSolverOptions so;
+	so.maxIterations = o.iterationsPerRound;
+	std::vector<PoseResidualTerm> used;
+	used.reserve(n);
 	for (int round = 0; round < o.rounds; round++)
 	{
-		ceres::Problem::Options po;
-		po.manifold_ownership = ceres::TAKE_OWNERSHIP;
-		po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
-		ceres::Problem problem(po);
-		problem.AddParameterBlock(q, 4, new ceres::EigenQuaternionManifold());
-		problem.AddParameterBlock(t, 3);
-		int used = 0;
+		used.clear();
 		for (std::size_t i = 0; i < n; i++)
 		{
 			if (!res.inlier[i]) continue;
-			const auto& ob = obs[i];
+			used.push_back(all[i]);
 			// Huber only in the first rounds: later rounds see inliers only (as ORB-SLAM2).
-			ceres::LossFunction* loss = nullptr;
-			if (round < o.rounds - 1) loss = useDepth(ob) ? &huberRgbd : &huberMono;
-			const AnalyticReprojectionCost cost(ob.uv, useDepth(ob) ? ob.depth : 0.0, o.bf, ob.invSigma, 1.0 / o.disparitySigma, K);
-			problem.AddResidualBlock(new AnalyticPoseCost(cost, ob.p_world), loss, q, t);
-			++used;
+			used.back().huberDelta = round < o.rounds - 1 ? std::sqrt(inlierThreshold(obs[i], o)) : 0.0;
 		}
-		if (used < 3) break;
-		ceres::Solver::Summary summary;
-		ceres::Solve(so, &problem, &summary);
+		if (used.size() < 3) break;
+		solvePoseLevenbergMarquardt(R, t, used, K, o.bf, so);
 		// Re-classify every observation (outliers may come back) at the new estimate.
-		for (std::size_t i = 0; i < n; i++)
-			res.inlier[i] = chi2(obs[i]) <= (useDepth(obs[i]) ? o.chi2Rgbd : o.chi2Mono);
+		for (std::size_t i = 0; i < n; i++) res.inlier[i] = chi2(i) <= inlierThreshold(obs[i], o);
 	}
 	res.inliers = 0;
 	double sq = 0;
@@ -186,13 +172,17 @@ PoseOptimizerResult optimizePose(
 	{
 		if (!res.inlier[i]) continue;
 		res.inliers++;
-		double u, v, ur;
-		const double p[3] = {obs[i].p_world.x(), obs[i].p_world.y(), obs[i].p_world.z()};
-		projectRgbd(q, t, p, K, o.bf, u, v, ur);
-		sq += (obs[i].uv - Eigen::Vector2d(u, v)).squaredNorm();
+		PoseResidualTerm uvOnly = all[i];
+		uvOnly.invSigma = 1.0;
+		uvOnly.disparity = 0;
+		double e = 0;
+		poseResidualSquaredNorm(R, t, uvOnly, K, o.bf, e);
+		sq += e;
 	}
 	res.rmsPixels = res.inliers ? std::sqrt(sq / res.inliers) : 0.0;
-	T_world_cam = fromCeres(q, t);
+	const Eigen::Quaterniond qr(R);
+	const double qOut[4] = {qr.x(), qr.y(), qr.z(), qr.w()};
+	T_world_cam = fromCeres(qOut, t.data());
 	return res;
 }
 

@@ -361,6 +361,91 @@ bool LoopCloser::plausible(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eige
 	return dt <= m_opts.maxCorrectionBase + m_opts.maxCorrectionRatio * path && dr <= m_opts.maxCorrectionDeg;
 }
 
+namespace
+{
+using KeyFramePoses = std::map<sfm::KeyFrameId, Eigen::Isometry3d>;
+
+/** Every keyframe's T_world_cam as an isometry. */
+KeyFramePoses keyFramePoses(const sfm::SparseMap& map)
+{
+	KeyFramePoses poses;
+	for (const auto& [id, kf] : map.keyframes()) poses[id] = toIsometry(kf.T_world_cam);
+	return poses;
+}
+
+/** The pose graph of a loop correction (see LoopCloser::correct): a vertex per keyframe, the
+ * keyframes of the current map moved first by `align`; odometry edges between consecutive
+ * keyframes of one map and covisibility edges between strongly covisible ones, all keeping
+ * their current relative poses; the loop edge with its measurement; the gauge fixed. */
+loop::PoseGraph loopCorrectionGraph(
+	const sfm::SparseMap& map, const KeyFramePoses& oldIso, sfm::KeyFrameId cur, sfm::KeyFrameId cand,
+	const Eigen::Isometry3d& T_cand_cur, const Eigen::Isometry3d& align, int covisibilityEdgeMinWeight)
+{
+	const std::uint32_t curMap = map.keyframe(cur).mapId;
+	const bool merge = curMap != map.keyframe(cand).mapId;
+	loop::PoseGraph g;
+	for (const auto& [id, kf] : map.keyframes()) g.addVertex(id, kf.mapId == curMap ? align * oldIso.at(id) : oldIso.at(id));
+	auto rel = [&](sfm::KeyFrameId a, sfm::KeyFrameId b) { return g.pose(a).inverse() * g.pose(b); };
+	std::map<std::uint32_t, sfm::KeyFrameId> prevOfMap;
+	for (const auto& [id, kf] : map.keyframes())
+	{
+		const auto p = prevOfMap.find(kf.mapId);
+		const bool hasPrev = p != prevOfMap.end();
+		const sfm::KeyFrameId prev = hasPrev ? p->second : 0;
+		if (hasPrev) g.addEdge({prev, id, rel(prev, id), loop::Matrix6d::Identity(), loop::EdgeKind::Odometry});
+		for (const auto& [other, w] : kf.covisibility)
+			if (other < id && w >= covisibilityEdgeMinWeight && (!hasPrev || other != prev))
+				g.addEdge({other, id, rel(other, id), loop::Matrix6d::Identity(), loop::EdgeKind::Covisibility});
+		prevOfMap[kf.mapId] = id;
+	}
+	g.addEdge({cand, cur, T_cand_cur, loop::Matrix6d::Identity(), loop::EdgeKind::Loop});
+	// Gauge: the first keyframe defines the world frame; the loop only bends the rest onto
+	// it. A loop inside a map not merged yet keeps that map's first keyframe in place.
+	g.setFixed(map.keyframes().begin()->first);
+	if (!merge && map.keyframes().begin()->second.mapId != curMap)
+		for (const auto& [id, kf] : map.keyframes())
+			if (kf.mapId == curMap)
+			{
+				g.setFixed(id);
+				break;
+			}
+	return g;
+}
+
+/** Landmarks follow the keyframe that created them (or their first observer) from its pose in
+ * oldIso to its pose in newIso; landmarks of keyframes not corrected stay. */
+void moveLandmarksWithKeyFrames(sfm::SparseMap& map, const KeyFramePoses& oldIso, const KeyFramePoses& newIso)
+{
+	std::vector<std::pair<sfm::LandmarkId, Eigen::Vector3d>> moved;
+	for (const auto& [id, lm] : map.landmarks())
+	{
+		sfm::KeyFrameId ref = lm.firstKeyFrame;
+		if (!newIso.count(ref)) ref = lm.observations.begin()->first;
+		if (!newIso.count(ref)) continue;
+		moved.emplace_back(id, loop::movePointWithKeyFrame(lm.p_world, oldIso.at(ref), newIso.at(ref)));
+	}
+	for (const auto& [id, p] : moved) map.landmark(id).p_world = p;
+}
+
+/** Joins both sides of a closed loop: the landmarks of the loop keyframe's neighbourhood are
+ * fused into the current keyframe's neighbourhood, whose covisibility is then updated. */
+void joinLoopSides(sfm::SparseMap& map, sfm::LocalMapper& mapper, sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K)
+{
+	std::set<sfm::LandmarkId> loopSide;
+	std::vector<sfm::KeyFrameId> loopGroup = {cand}, curGroup = {cur};
+	for (auto n : map.bestCovisibles(cand, 5)) loopGroup.push_back(n);
+	for (auto n : map.bestCovisibles(cur, 5)) curGroup.push_back(n);
+	for (auto id : loopGroup)
+		for (auto l : map.keyframe(id).landmarks)
+			if (l != sfm::kNoLandmark) loopSide.insert(l);
+	const std::vector<sfm::LandmarkId> lms(loopSide.begin(), loopSide.end());
+	for (auto id : curGroup)
+		if (map.hasKeyFrame(id)) mapper.fuseLandmarks(id, lms, K);
+	for (auto id : curGroup)
+		if (map.hasKeyFrame(id)) map.updateCovisibility(id);
+}
+}  // namespace
+
 LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K)
 {
 	// Pose graph: every keyframe; consecutive keyframes and strong covisibility pairs keep
@@ -374,37 +459,8 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 	const bool merge = curMap != loopMap;
 	const Eigen::Isometry3d align = merge ? toIsometry(m_map.keyframe(cand).T_world_cam) * T_cand_cur * toIsometry(m_map.keyframe(cur).T_world_cam).inverse()
 										  : Eigen::Isometry3d::Identity();
-	loop::PoseGraph g;
-	std::map<sfm::KeyFrameId, Eigen::Isometry3d> oldIso, newIso;
-	for (const auto& [id, kf] : m_map.keyframes())
-	{
-		oldIso[id] = toIsometry(kf.T_world_cam);
-		g.addVertex(id, kf.mapId == curMap ? align * oldIso[id] : oldIso[id]);
-	}
-	auto rel = [&](sfm::KeyFrameId a, sfm::KeyFrameId b) { return g.pose(a).inverse() * g.pose(b); };
-	std::map<std::uint32_t, sfm::KeyFrameId> prevOfMap;
-	for (const auto& [id, kf] : m_map.keyframes())
-	{
-		const auto p = prevOfMap.find(kf.mapId);
-		const bool hasPrev = p != prevOfMap.end();
-		const sfm::KeyFrameId prev = hasPrev ? p->second : 0;
-		if (hasPrev) g.addEdge({prev, id, rel(prev, id), loop::Matrix6d::Identity(), loop::EdgeKind::Odometry});
-		for (const auto& [other, w] : kf.covisibility)
-			if (other < id && w >= m_opts.covisibilityEdgeMinWeight && (!hasPrev || other != prev))
-				g.addEdge({other, id, rel(other, id), loop::Matrix6d::Identity(), loop::EdgeKind::Covisibility});
-		prevOfMap[kf.mapId] = id;
-	}
-	g.addEdge({cand, cur, T_cand_cur, loop::Matrix6d::Identity(), loop::EdgeKind::Loop});
-	// Gauge: the first keyframe defines the world frame; the loop only bends the rest onto
-	// it. A loop inside a map not merged yet keeps that map's first keyframe in place.
-	g.setFixed(m_map.keyframes().begin()->first);
-	if (!merge && m_map.keyframes().begin()->second.mapId != curMap)
-		for (const auto& [id, kf] : m_map.keyframes())
-			if (kf.mapId == curMap)
-			{
-				g.setFixed(id);
-				break;
-			}
+	KeyFramePoses oldIso = keyFramePoses(m_map), newIso;
+	loop::PoseGraph g = loopCorrectionGraph(m_map, oldIso, cur, cand, T_cand_cur, align, m_opts.covisibilityEdgeMinWeight);
 	const auto summary = g.optimize(m_opts.poseGraph);
 
 	LoopClosureEvent ev;
@@ -420,31 +476,9 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 		m_map.keyframe(c.id).T_world_cam = toCPose3D(c.T_world_kf_new);
 		ev.newPoses[c.id] = m_map.keyframe(c.id).T_world_cam;
 	}
-	// Landmarks follow the keyframe that created them (or their first observer).
-	std::vector<std::pair<sfm::LandmarkId, Eigen::Vector3d>> moved;
-	for (const auto& [id, lm] : m_map.landmarks())
-	{
-		sfm::KeyFrameId ref = lm.firstKeyFrame;
-		if (!newIso.count(ref)) ref = lm.observations.begin()->first;
-		if (!newIso.count(ref)) continue;
-		moved.emplace_back(id, loop::movePointWithKeyFrame(lm.p_world, oldIso[ref], newIso[ref]));
-	}
-	for (const auto& [id, p] : moved) m_map.landmark(id).p_world = p;
+	moveLandmarksWithKeyFrames(m_map, oldIso, newIso);
 	ev.correctionMetres = (newIso[cur].translation() - oldIso[cur].translation()).norm();
-
-	// Join both sides: the loop keyframe's neighbourhood landmarks into the current one's.
-	std::set<sfm::LandmarkId> loopSide;
-	std::vector<sfm::KeyFrameId> loopGroup = {cand}, curGroup = {cur};
-	for (auto n : m_map.bestCovisibles(cand, 5)) loopGroup.push_back(n);
-	for (auto n : m_map.bestCovisibles(cur, 5)) curGroup.push_back(n);
-	for (auto id : loopGroup)
-		for (auto l : m_map.keyframe(id).landmarks)
-			if (l != sfm::kNoLandmark) loopSide.insert(l);
-	const std::vector<sfm::LandmarkId> lms(loopSide.begin(), loopSide.end());
-	for (auto id : curGroup)
-		if (m_map.hasKeyFrame(id)) m_mapper.fuseLandmarks(id, lms, K);
-	for (auto id : curGroup)
-		if (m_map.hasKeyFrame(id)) m_map.updateCovisibility(id);
+	joinLoopSides(m_map, m_mapper, cur, cand, K);
 	m_lastGraph = g;
 	return ev;
 }

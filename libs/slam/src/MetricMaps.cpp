@@ -1,8 +1,4 @@
-#include <keygrid/core/AtomicOutput.h>
 #include <keygrid/core/ConfigReading.h>
-#include <keygrid/core/FrameConventions.h>
-#include <keygrid/maps/CISMOccupancyGrid2D.h>
-#include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SimpleMapExport.h>
@@ -11,8 +7,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <filesystem>
-#include <functional>
 #include <map>
 #include <regex>
 #include <set>
@@ -45,28 +39,6 @@ bool knownMapType(const std::string& name)
 			if (part == name) return true;
 	}
 	return false;
-}
-
-/** A depth-only observation of a keyframe, for MRPT's own maps. */
-mrpt::obs::CObservation3DRangeScan::Ptr depthObservation(const sfm::KeyFrame& kf, const cv::Mat& depth)
-{
-	auto obs = mrpt::obs::CObservation3DRangeScan::Create();
-	const auto& cam = kf.features.camera;
-	obs->hasRangeImage = true;
-	obs->range_is_depth = true;
-	obs->rangeUnits = cam.depthUnits;
-	obs->rangeImage.resize(depth.rows, depth.cols);
-	for (int r = 0; r < depth.rows; r++)
-		for (int c = 0; c < depth.cols; c++)
-		{
-			const double q = std::round(depth.at<float>(r, c) / cam.depthUnits);
-			obs->rangeImage(r, c) = q > 0 && q < 65535 ? static_cast<uint16_t>(q) : 0;
-		}
-	obs->cameraParams = cam.toTCamera();
-	obs->cameraParamsIntensity = obs->cameraParams;
-	obs->relativePoseIntensityWRTDepth = core::T_depth_cam();
-	obs->maxRange = 10.0f;
-	return obs;
 }
 }  // namespace
 
@@ -173,33 +145,20 @@ MetricMaps::MetricMaps(
 		throw std::invalid_argument(
 			std::string("[") + kSection + "] asks for " + std::to_string(requested) + " maps but " +
 			std::to_string(m_maps.maps.size()) + " were created");
-	// Every 2D grid takes the run's floor frame. A grid's own floor pose would be silently
-	// replaced: refuse it, naming where the floor of a keygrid-slam run is given.
-	for (std::size_t i = 0; i < m_maps.maps.size(); i++)
-		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m_maps.maps[i].get()))
-		{
-			const auto& io = ism->insertionOptions;
-			if (!io.estimateFloorFromDepth && !maps::ExportFrame{io.T_world_floor, {}}.isIdentity())
-				throw std::invalid_argument(
-					std::string("[") + kSection + "_ismOccupancyGrid2D_" + (i < 10 ? "0" : "") + std::to_string(i) +
-					"_insertOpts] T_world_floor: keygrid-slam gives every map the run's one floor frame; set it as "
-					"[floor] T_world_floor instead");
-			if (m_floor.T_world_floor())
-				ism->setExternalFloorPose(*m_floor.T_world_floor());
-			else
-				ism->expectExternalFloorPose();
-		}
+	listKeyFrameMaps();
+	// Every map takes the run's floor frame (a 2D grid refuses one of its own).
+	for (auto* m : m_keyFrameMaps) m->setFloorFrame(m_floor.T_world_floor());
 }
 
-void MetricMaps::floorChanged()
+void MetricMaps::listKeyFrameMaps()
 {
+	m_keyFrameMaps.clear();
+	m_observationFedMaps.clear();
 	for (auto& m : m_maps.maps)
-		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
-		{
-			ism->setExternalFloorPose(*m_floor.T_world_floor());
-			// The keyframes integrated so far, again in the new floor frame (cheap).
-			if (!ism->keyframes().empty()) ism->applyTrajectoryCorrection({});
-		}
+		if (auto* km = dynamic_cast<maps::KeyFrameMap*>(m.get()))
+			m_keyFrameMaps.push_back(km);
+		else
+			m_keyFrameMaps.push_back(m_observationFedMaps.emplace_back(std::make_unique<maps::ObservationFedMap>(*m)).get());
 }
 
 maps::ExportFrame MetricMaps::outputFrame() const
@@ -209,81 +168,58 @@ maps::ExportFrame MetricMaps::outputFrame() const
 	return {mrpt::poses::CPose3D(), "keygrid frame: SLAM world (the first camera's optical frame; no floor estimate)"};
 }
 
+maps::MapKeyFrame MetricMaps::mapKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, double travelled) const
+{
+	const auto& kf = map.keyframe(id);
+	maps::MapKeyFrame out;
+	out.id = id;
+	out.T_world_cam = kf.T_world_cam;
+	out.camera = kf.features.camera;
+	out.depth = depthOf(kf);
+	for (sfm::LandmarkId l : kf.landmarks)
+		if (l != sfm::kNoLandmark && map.hasLandmark(l))
+		{
+			const auto& p = map.landmark(l).p_world;
+			out.points_world.emplace_back(p.x(), p.y(), p.z());
+		}
+	out.travelled = travelled;
+	return out;
+}
+
 void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, double travelled)
 {
 	if (empty()) return;
-	const auto& kf = map.keyframe(id);
-	const cv::Mat depth = depthOf(kf);
+	const maps::MapKeyFrame kf = mapKeyFrame(map, id, travelled);
 	m_insertedPoses[id] = kf.T_world_cam;
+	m_travelled[id] = travelled;
 	// The floor first, so that the keyframe enters the 2D grids in the newest floor frame.
 	// Samples of its depth image, else its map points.
 	if (!m_floor.given())
 	{
 		std::vector<mrpt::math::TPoint3Df> samples;
-		if (!depth.empty())
+		if (!kf.depth.empty())
 		{
-			const cv::Mat d = depth.isContinuous() ? depth : depth.clone();
-			const auto& cam = kf.features.camera;
+			const cv::Mat d = kf.depth.isContinuous() ? kf.depth : kf.depth.clone();
+			const auto& cam = kf.camera;
 			samples = maps::FloorFrameEstimator::depthSamples(d.ptr<float>(), d.rows, d.cols, cam.fx, cam.fy, cam.cx, cam.cy, m_floor.options());
 		}
 		else
-			for (sfm::LandmarkId l : kf.landmarks)
-				if (l != sfm::kNoLandmark && map.hasLandmark(l))
-				{
-					const auto& p = map.landmark(l).p_world;
-					const auto q = kf.T_world_cam.inverseComposePoint(mrpt::math::TPoint3D(p.x(), p.y(), p.z()));
-					samples.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
-				}
-		if (m_floor.addKeyframe(id, kf.T_world_cam, samples, kf.timestamp)) floorChanged();
-	}
-	mrpt::obs::CObservation3DRangeScan::Ptr obs;  // built on demand
-	for (std::size_t i = 0; i < m_maps.maps.size(); i++)
-	{
-		auto& m = m_maps.maps[i];
-		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
-		{
-			if (m_feed.ism2dInput == "dense" && !depth.empty())
+			for (const auto& p : kf.points_world)
 			{
-				// Dense input is reduced in the floor frame: it waits for the floor.
-				auto& pending = m_pendingDense[i];
-				if (!ism->floorKnown())
-				{
-					pending.push_back(id);
-					continue;
-				}
-				for (sfm::KeyFrameId p : pending)
-					if (map.hasKeyFrame(p))
-					{
-						const auto& pk = map.keyframe(p);
-						ism->insertKeyframeDepth(p, pk.T_world_cam, *depthObservation(pk, depthOf(pk)));
-					}
-				pending.clear();
-				if (!obs) obs = depthObservation(kf, depth);
-				ism->insertKeyframeDepth(id, kf.T_world_cam, *obs);
-				continue;
+				const auto q = kf.T_world_cam.inverseComposePoint(p);
+				samples.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
 			}
-			// Sparse input is stored also before the floor is known, and integrated then.
-			std::vector<mrpt::math::TPoint3D> pts;
-			for (sfm::LandmarkId l : kf.landmarks)
-				if (l != sfm::kNoLandmark && map.hasLandmark(l))
-				{
-					const auto& p = map.landmark(l).p_world;
-					pts.emplace_back(p.x(), p.y(), p.z());
-				}
-			ism->insertKeyframePoints(id, kf.T_world_cam, pts);
-		}
-		else if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get()))
-		{
-			if (!depth.empty()) g3->insertDepthFrame(depth, kf.features.camera, kf.T_world_cam, travelled, id);
-		}
-		else if (dynamic_cast<CHOCPointsMap*>(m.get()))
-			continue;  // filled from the frontend's landmarks (syncLandmarks)
-		else if (!depth.empty())
-		{
-			if (!obs) obs = depthObservation(kf, depth);
-			m->insertObservation(*obs, mrpt::poses::CPose3D(core::sensorPoseFromCameraPose(kf.T_world_cam)));
-		}
+		if (m_floor.addKeyframe(id, kf.T_world_cam, samples, map.keyframe(id).timestamp))
+			for (auto* m : m_keyFrameMaps) m->setFloorFrame(m_floor.T_world_floor());
 	}
+	maps::KeyFrameFeed feed;
+	feed.gridInput = m_feed.ism2dInput == "dense" ? maps::GridInput::Depth : maps::GridInput::MapPoints;
+	feed.keyFrame = [&](uint64_t earlier) -> std::optional<maps::MapKeyFrame> {
+		if (!map.hasKeyFrame(earlier)) return std::nullopt;
+		const auto t = m_travelled.find(earlier);
+		return mapKeyFrame(map, earlier, t != m_travelled.end() ? t->second : 0.0);
+	};
+	for (auto* m : m_keyFrameMaps) m->insertKeyFrame(kf, feed);
 }
 
 cv::Mat MetricMaps::depthOf(const sfm::KeyFrame& kf) const
@@ -295,37 +231,21 @@ cv::Mat MetricMaps::depthOf(const sfm::KeyFrame& kf) const
 std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses)
 {
 	std::map<std::string, double> out;
+	maps::MapCorrection correction;
 	{
-		// The floor under the corrected poses; the 2D grids are rebuilt below anyway.
+		// The floor under the corrected poses; the maps in it are re-anchored below anyway.
 		const auto t0 = std::chrono::steady_clock::now();
 		std::map<uint64_t, mrpt::poses::CPose3D> np(newPoses.begin(), newPoses.end());
-		if (m_floor.updatePoses(np))
-			for (auto& m : m_maps.maps)
-				if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get())) ism->setExternalFloorPose(*m_floor.T_world_floor());
+		if (m_floor.updatePoses(np)) correction.T_world_floor = m_floor.T_world_floor();
 		out["floor"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}
-	for (auto& m : m_maps.maps)
+	for (const auto& [id, T] : newPoses)
+		if (m_insertedPoses.count(id)) correction.poses[id] = PoseCorrection{m_insertedPoses.at(id), T};
+	for (std::size_t i = 0; i < m_keyFrameMaps.size(); i++)
 	{
 		const auto t0 = std::chrono::steady_clock::now();
-		std::string name = m->GetRuntimeClass()->className;
-		if (auto* ism = dynamic_cast<CISMOccupancyGrid2D*>(m.get()))
-		{
-			if (!ism->floorKnown()) continue;  // nothing integrated yet: no floor frame
-			std::map<uint64_t, mrpt::poses::CPose3D> np;
-			for (const auto& [id, T] : newPoses)
-				if (ism->keyframes().count(id)) np[id] = T;
-			ism->applyTrajectoryCorrection(np);
-		}
-		else if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get()))
-		{
-			TrajectoryCorrection corr;
-			for (const auto& [id, T] : newPoses)
-				if (m_insertedPoses.count(id)) corr[id] = PoseCorrection{m_insertedPoses.at(id), T};
-			g3->morphAndMergeSubmaps(corr);
-		}
-		else
-			continue;  // MRPT's own maps cannot be re-anchored: they keep the online poses
-		out[name] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+		if (m_keyFrameMaps[i]->applyCorrection(correction))
+			out[m_maps.maps[i]->GetRuntimeClass()->className] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}
 	for (const auto& [id, T] : newPoses)
 		if (m_insertedPoses.count(id)) m_insertedPoses[id] = T;
@@ -334,23 +254,13 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 
 void MetricMaps::syncLandmarks(const sfm::SparseMap& map, const maps::HocOptions& hoc)
 {
-	for (auto& m : m_maps.maps)
-		if (auto* h = dynamic_cast<CHOCPointsMap*>(m.get()))
-		{
-			const auto render = h->renderOptions;
-			const auto ins = h->insertionOptions;
-			const auto lik = h->likelihoodOptions;
-			*h = hocPointsFromLandmarks(map, hoc);
-			h->renderOptions = render;
-			h->insertionOptions = ins;
-			h->likelihoodOptions = lik;
-		}
+	const maps::LandmarkSource landmarks = [&] { return hocPointsFromLandmarks(map, hoc); };
+	for (auto* m : m_keyFrameMaps) m->syncLandmarks(landmarks);
 }
 
 void MetricMaps::notifyLoopClosure()
 {
-	for (auto& m : m_maps.maps)
-		if (auto* g3 = dynamic_cast<CSubmappedOccupancyGrid3D*>(m.get())) g3->notifyLoopClosure();
+	for (auto* m : m_keyFrameMaps) m->notifyLoopClosure();
 }
 
 MetricMaps MetricMaps::FromMaps(
@@ -359,100 +269,33 @@ MetricMaps MetricMaps::FromMaps(
 	MetricMaps out(MapFeedOptions{}, maps::FloorFrameOptions{});
 	out.m_restoredFloor = T_world_floor;
 	for (const auto& m : maps) out.m_maps.maps.push_back(m);
+	out.listKeyFrameMaps();
 	return out;
 }
 
 std::vector<std::string> MetricMaps::writeOutputs(const std::string& dir) const
 {
-	namespace fs = std::filesystem;
-	const maps::ExportFrame frame = outputFrame();
-	std::vector<std::string> files;
+	maps::MapOutputFolder out(dir, outputFrame());
 	std::map<std::string, int> seen;
-	// Every file is tried: one that fails (full disk) does not keep the others from being
-	// written. The first failure is thrown at the end.
-	std::string firstError;
-	std::size_t failures = 0;
-	auto attempt = [&](const std::string& file, const std::function<void(const std::string&)>& write) {
-		try
-		{
-			write(dir + "/" + file);
-			files.push_back(file);
-			return true;
-		}
-		catch (const std::exception& e)
-		{
-			if (firstError.empty()) firstError = e.what();
-			failures++;
-			return false;
-		}
-	};
-	for (const auto& m : m_maps.maps)
+	for (std::size_t i = 0; i < m_keyFrameMaps.size(); i++)
 	{
-		const std::string cls = m->GetRuntimeClass()->className;
-		const int n = seen[cls]++;
-		const std::string suffix = n ? "_" + std::to_string(n) : "";
-		// keygrid's maps write each file atomically (core/AtomicOutput.h).
-		if (const auto* ism = dynamic_cast<const CISMOccupancyGrid2D*>(m.get()))
-		{
-			if (attempt("map_2d" + suffix + ".yaml", [&](const std::string& p) { ism->saveAsRosMapServer(p); }))
-				files.push_back("map_2d" + suffix + ".pgm");  // written first, beside the .yaml
-			attempt("map_2d" + suffix + ".png", [&](const std::string& p) { ism->saveAsImage(p); });
-			attempt("map_2d" + suffix + ".bin", [&](const std::string& p) { core::saveGzAtomically(*ism, p); });
-		}
-		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
-		{
-			attempt("map_3d" + suffix + ".bt", [&](const std::string& p) { g3->saveAsOctomapBinary(p, frame); });
-			attempt("map_3d" + suffix + ".ply", [&](const std::string& p) { g3->saveOccupiedAsPly(p, frame); });
-			attempt("map_3d" + suffix + ".bin", [&](const std::string& p) { core::saveGzAtomically(*g3, p); });
-		}
-		else if (const auto* hoc = dynamic_cast<const CHOCPointsMap*>(m.get()))
-		{
-			attempt("hoc_points" + suffix + ".ply", [&](const std::string& p) { hoc->saveAsPly(p, frame); });
-			attempt("hoc_points" + suffix + ".bin", [&](const std::string& p) { core::saveGzAtomically(*hoc, p); });
-		}
-		else
-		{
-			// MRPT's own representation (e.g. octoMap writes .bt, pointsMap .txt), by writers that
-			// take a file prefix: written into a scratch folder, then renamed into place.
-			std::string base = cls;
-			for (auto& ch : base)
-				if (ch == ':') ch = '_';
-			attempt(base + suffix + ".*", [&](const std::string&) {
-				const fs::path tmp = fs::path(dir) / ".maps.tmp";
-				fs::remove_all(tmp);
-				fs::create_directories(tmp);
-				m->saveMetricMapRepresentationToFile((tmp / (base + suffix)).string());
-				for (const auto& e : fs::directory_iterator(tmp)) fs::rename(e.path(), fs::path(dir) / e.path().filename());
-				fs::remove_all(tmp);
-			});
-		}
+		const int n = seen[m_maps.maps[i]->GetRuntimeClass()->className]++;
+		m_keyFrameMaps[i]->writeOutputs(out, n ? "_" + std::to_string(n) : "");
 	}
-	if (failures > 1) firstError += " (and " + std::to_string(failures - 1) + " more map files not written)";
-	if (!firstError.empty()) throw std::runtime_error(firstError);
-	return files;
+	out.throwIfAnyFailed();
+	return out.files();
 }
 
 std::string MetricMaps::summaryJson() const
 {
 	std::ostringstream o;
 	o << "[";
-	bool first = true;
-	for (const auto& m : m_maps.maps)
+	for (std::size_t i = 0; i < m_keyFrameMaps.size(); i++)
 	{
-		o << (first ? "" : ", ") << "{\"class\": \"" << m->GetRuntimeClass()->className << "\"";
-		if (const auto* ism = dynamic_cast<const CISMOccupancyGrid2D*>(m.get()))
-		{
-			const auto c = ism->countStates();
-			o << ", \"cells\": " << ism->sizeX() * ism->sizeY() << ", \"states\": [" << c[0] << ", " << c[1] << ", " << c[2]
-			  << "], \"keyframes\": " << ism->keyframes().size();
-		}
-		else if (const auto* hoc = dynamic_cast<const CHOCPointsMap*>(m.get()))
-			o << ", \"points\": " << hoc->size();
-		else if (const auto* g3 = dynamic_cast<const CSubmappedOccupancyGrid3D*>(m.get()))
-			o << ", \"submaps\": " << g3->numSubmaps() << ", \"memory_bytes\": " << g3->memoryBytes()
-			  << ", \"keyframes\": " << g3->keyframes().size();
+		o << (i ? ", " : "") << "{\"class\": \"" << m_maps.maps[i]->GetRuntimeClass()->className << "\"";
+		const std::string fields = m_keyFrameMaps[i]->summaryJsonFields();
+		if (!fields.empty()) o << ", " << fields;
 		o << "}";
-		first = false;
 	}
 	o << "]";
 	return o.str();

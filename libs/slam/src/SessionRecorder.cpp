@@ -157,45 +157,29 @@ store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const Lo
 {
 	store::SessionWriteJob job;
 	auto& u = job.update;
-	std::set<sfm::KeyFrameId> dirtyAssociations;
-	// Keyframes: new ones whole (with images), moved ones as poses, erased ones by id.
+	diffKeyFrames(map, loop, job);
+	const std::set<sfm::KeyFrameId> dirtyAssociations = diffLandmarks(map, withCounters, u);
+	u.attributes.swap(m_attributes);
+	m_attributes.clear();
+	// New keyframes carry their association in their record; erased ones have none.
+	std::set<sfm::KeyFrameId> fresh;
+	for (const auto& r : u.keyframes) fresh.insert(r.id);
+	for (const auto kf : dirtyAssociations)
+		if (!fresh.count(kf) && m_keyframes.count(kf) && map.hasKeyFrame(kf)) u.associations.push_back({kf, map.keyframe(kf).landmarks});
+	return job;
+}
+
+void SessionRecorder::diffKeyFrames(const sfm::SparseMap& map, const LoopCloser* loop, store::SessionWriteJob& job)
+{
+	auto& u = job.update;
 	for (const auto& [id, kf] : map.keyframes())
 	{
 		if (kf.mapId != 0) continue;  // a map not merged yet has no place in the file's frame
 		auto it = m_keyframes.find(id);
 		if (it == m_keyframes.end())
-		{
-			const loop::BowVector* bow = loop ? loop->bowOf(id) : nullptr;
-			u.keyframes.push_back(store::toRecord(kf, bow ? *bow : loop::BowVector{}));
-			store::KeyFrameImageSource img;
-			if (m_opts.images)
-			{
-				img.colour = kf.colour;
-				img.depth = kf.depth;
-				img.depthUnits = kf.features.camera.depthUnits;
-			}
-			job.images.push_back(img);
-			for (const auto& e : store::covisibilityOf(kf)) u.covisibility.push_back(e);
-			m_keyframes[id] = {kf.T_world_cam, kf.covisibility};
-			m_stats.keyframesWritten++;
-			continue;
-		}
-		if (!samePose(it->second.T_world_cam, kf.T_world_cam))
-		{
-			u.poses.push_back({id, kf.T_world_cam});
-			it->second.T_world_cam = kf.T_world_cam;
-		}
-		if (it->second.covisibility != kf.covisibility)
-		{
-			for (const auto& [other, w] : kf.covisibility)
-			{
-				const auto old = it->second.covisibility.find(other);
-				if (old == it->second.covisibility.end() || old->second != w) u.covisibility.push_back({std::min(id, other), std::max(id, other), w});
-			}
-			for (const auto& [other, w] : it->second.covisibility)
-				if (!kf.covisibility.count(other)) u.covisibility.push_back({std::min(id, other), std::max(id, other), 0});
-			it->second.covisibility = kf.covisibility;
-		}
+			addNewKeyFrame(id, kf, loop, job);
+		else
+			diffWrittenKeyFrame(id, kf, it->second, u);
 	}
 	for (auto it = m_keyframes.begin(); it != m_keyframes.end();)
 	{
@@ -207,8 +191,46 @@ store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const Lo
 		u.erasedKeyFrames.push_back(it->first);
 		it = m_keyframes.erase(it);
 	}
-	// Landmarks: written when any field changed; the keyframes observing them (before and
-	// now) get their keypoint -> landmark association rewritten.
+}
+
+void SessionRecorder::addNewKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, const LoopCloser* loop, store::SessionWriteJob& job)
+{
+	const loop::BowVector* bow = loop ? loop->bowOf(id) : nullptr;
+	job.update.keyframes.push_back(store::toRecord(kf, bow ? *bow : loop::BowVector{}));
+	store::KeyFrameImageSource img;
+	if (m_opts.images)
+	{
+		img.colour = kf.colour;
+		img.depth = kf.depth;
+		img.depthUnits = kf.features.camera.depthUnits;
+	}
+	job.images.push_back(img);
+	for (const auto& e : store::covisibilityOf(kf)) job.update.covisibility.push_back(e);
+	m_keyframes[id] = {kf.T_world_cam, kf.covisibility};
+	m_stats.keyframesWritten++;
+}
+
+void SessionRecorder::diffWrittenKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, WrittenKeyFrame& written, store::SessionUpdate& u)
+{
+	if (!samePose(written.T_world_cam, kf.T_world_cam))
+	{
+		u.poses.push_back({id, kf.T_world_cam});
+		written.T_world_cam = kf.T_world_cam;
+	}
+	if (written.covisibility == kf.covisibility) return;
+	for (const auto& [other, w] : kf.covisibility)
+	{
+		const auto old = written.covisibility.find(other);
+		if (old == written.covisibility.end() || old->second != w) u.covisibility.push_back({std::min(id, other), std::max(id, other), w});
+	}
+	for (const auto& [other, w] : written.covisibility)
+		if (!kf.covisibility.count(other)) u.covisibility.push_back({std::min(id, other), std::max(id, other), 0});
+	written.covisibility = kf.covisibility;
+}
+
+std::set<sfm::KeyFrameId> SessionRecorder::diffLandmarks(const sfm::SparseMap& map, bool withCounters, store::SessionUpdate& u)
+{
+	std::set<sfm::KeyFrameId> dirtyAssociations;
 	for (const auto& [id, lm] : map.landmarks())
 	{
 		if (!lm.observations.empty() && map.keyframe(lm.observations.begin()->first).mapId != 0) continue;
@@ -238,14 +260,7 @@ store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const Lo
 		it = m_landmarks.erase(it);
 	}
 	m_stats.landmarksWritten += u.landmarks.size();
-	u.attributes.swap(m_attributes);
-	m_attributes.clear();
-	// New keyframes carry their association in their record; erased ones have none.
-	std::set<sfm::KeyFrameId> fresh;
-	for (const auto& r : u.keyframes) fresh.insert(r.id);
-	for (const auto kf : dirtyAssociations)
-		if (!fresh.count(kf) && m_keyframes.count(kf) && map.hasKeyFrame(kf)) u.associations.push_back({kf, map.keyframe(kf).landmarks});
-	return job;
+	return dirtyAssociations;
 }
 
 void SessionRecorder::addSnapshots(store::SessionUpdate& u, const sfm::SparseMap& map, const MetricMaps& maps)

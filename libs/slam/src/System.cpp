@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <future>
 #include <set>
 #include <stdexcept>
 
@@ -238,9 +239,15 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 			m_waitingForMerge.push_back(job);
 		else
 			m_maps->insertKeyFrame(m_map, job.keyframe, job.travelled);
-		const auto t1 = std::chrono::steady_clock::now();
-		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
-		m_timings.add("map_insertion:sync_landmarks", secondsSince(t1));
+		// The landmark maps (hocPointsMap) are copies of the frontend's landmarks that only the
+		// session store's snapshots and the final outputs read: copied when a snapshot is due
+		// and in finish(), not at every keyframe (a copy costs the whole map).
+		if (m_recorder && m_recorder->snapshotDueAtNextKeyFrame())
+		{
+			const auto t1 = std::chrono::steady_clock::now();
+			m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+			m_timings.add("map_insertion:sync_landmarks", secondsSince(t1));
+		}
 		m_timings.add("map_insertion", secondsSince(t0));
 	}
 	const auto ev = closeLoops(job, tf);
@@ -290,23 +297,35 @@ std::optional<LoopClosureEvent> System::closeLoops(const KeyFrameJob& job, sfm::
 	auto ev = m_loopCloser->process(job.keyframe, job.frameIndex, job.K);
 	m_timings.add("loop_closing", secondsSince(t0));
 	if (!ev) return std::nullopt;
-	m_map.noteCorrection();
-	if (tf)
-	{
-		// Sequential: the frame that created the keyframe is the tracker's last frame.
-		m_tracker.onMapCorrected(m_map.keyframe(job.keyframe).T_world_cam);
-		tf->T_world_cam = m_map.keyframe(job.keyframe).T_world_cam;
-		m_lastTrackedPose = tf->T_world_cam;
-		m_correctionsSeen = m_map.corrections();
-	}
-	else
-		m_tracker.onMapCorrected();  // tracking went on: its last frame follows its reference
-	if (m_maps)
-	{
-		for (const auto& [name, sec] : m_maps->applyCorrection(ev->newPoses)) m_timings.add("map_correction:" + name, sec);
-		m_maps->notifyLoopClosure();
-	}
+	PoseCorrection c{PoseCorrection::Source::LoopClosure, ev->newPoses, job.keyframe};
+	for (const auto& [name, sec] : publishCorrection(c, tf)) m_timings.add(name, sec);
 	return ev;
+}
+
+std::map<std::string, double> System::publishCorrection(const PoseCorrection& c, sfm::TrackedFrame* tf)
+{
+	if (c.source == PoseCorrection::Source::LoopClosure)
+	{
+		// The tracker: its last pose (and threaded tracking's check for corrections).
+		m_map.noteCorrection();
+		if (tf)
+		{
+			// Sequential: the frame that created the keyframe is the tracker's last frame.
+			m_tracker.onMapCorrected(m_map.keyframe(c.keyframe).T_world_cam);
+			tf->T_world_cam = m_map.keyframe(c.keyframe).T_world_cam;
+			m_lastTrackedPose = tf->T_world_cam;
+			m_correctionsSeen = m_map.corrections();
+		}
+		else
+			m_tracker.onMapCorrected();  // tracking went on: its last frame follows its reference
+	}
+	// The frames follow their reference keyframes by themselves (trajectory()); the metric
+	// maps are re-anchored.
+	std::map<std::string, double> seconds;
+	if (!m_maps) return seconds;
+	for (const auto& [name, sec] : m_maps->applyCorrection(c.newPoses)) seconds["map_correction:" + name] = sec;
+	if (c.source == PoseCorrection::Source::LoopClosure) m_maps->notifyLoopClosure();
+	return seconds;
 }
 
 void System::waitForMapping()
@@ -417,8 +436,6 @@ void System::finish()
 	joinThreads();
 	if (m_finished || !m_K || m_map.numKeyFrames() == 0) return;
 	m_finished = true;
-	const auto& rc = m_cfg.refinement;
-	const auto t0 = std::chrono::steady_clock::now();
 	// Keyframe poses before the refinement (erased keyframes via their parents).
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> before;
 	for (const auto& [id, kf] : m_map.keyframes()) before[id] = kf.T_world_cam;  // also a loaded map's
@@ -427,48 +444,56 @@ void System::finish()
 		mrpt::poses::CPose3D T;
 		if (f.newKeyFrame && m_map.poseOf(f.keyframe, T)) before[f.keyframe] = T;
 	}
+	const auto window = adjustFinalMap();
+	// The maps' re-anchoring and the frames' re-estimation only read the adjusted map: they
+	// run side by side. The maps stay on this thread, whose heap still holds what the bundle
+	// adjustment freed (a new thread would allocate their rebuilt grids in a fresh malloc arena).
+	auto refinement = std::async(std::launch::async, [&] { refineFrames(window); });
+	const auto mapTimes = reanchorMaps(before);
+	refinement.get();
+	for (const auto& [name, sec] : mapTimes) m_timings.add(name, sec);
+	if (m_recorder) storeFinalSession();
+}
+
+std::optional<std::set<sfm::KeyFrameId>> System::adjustFinalMap()
+{
+	const auto t0 = std::chrono::steady_clock::now();
 	// Bounded: the keyframes around the closed loops and the newest ones move (see
 	// sfm::growBundleWindow); unbounded (small map or global_max_keyframes = 0): every one.
 	std::optional<std::set<sfm::KeyFrameId>> window;
-	if (rc.globalBundleAdjustment && m_map.numKeyFrames() > 1 && !m_localizeOnly)
+	if (m_cfg.refinement.globalBundleAdjustment && m_map.numKeyFrames() > 1 && !m_localizeOnly)
 	{
-		auto ba = finalBundleAdjustment(m_map, *m_K, m_loops, rc, m_cfg.mapping);
+		auto ba = finalBundleAdjustment(m_map, *m_K, m_loops, m_cfg.refinement, m_cfg.mapping);
 		m_globalBa = ba.report;
 		window = std::move(ba.window);
 	}
 	m_timings.add("global_bundle_adjustment", secondsSince(t0));
-	if (m_maps && !m_localizeOnly)
+	return window;
+}
+
+std::map<std::string, double> System::reanchorMaps(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& before)
+{
+	std::map<std::string, double> seconds;
+	if (!m_maps || m_localizeOnly) return seconds;
+	const auto& rc = m_cfg.refinement;
+	// Re-anchor the maps on the refined keyframe poses, unless no keyframe moved enough to
+	// show in them (a grid rebuild costs as much as the whole map).
+	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> poses;
+	for (const auto& [id, T0] : before)
 	{
-		// Re-anchor the maps on the refined keyframe poses, unless no keyframe moved enough
-		// to show in them (a grid rebuild costs as much as the whole map).
-		std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> poses;
-		for (const auto& [id, T0] : before)
-		{
-			mrpt::poses::CPose3D T;
-			if (m_map.poseOf(id, T)) poses[id] = T;
-		}
-		if (largestDisplacement(before, poses, rc.mapReanchorDepth) > rc.mapReanchorMinShift)
-			for (const auto& [name, sec] : m_maps->applyCorrection(poses)) m_timings.add("map_correction:" + name, sec);
-		m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+		mrpt::poses::CPose3D T;
+		if (m_map.poseOf(id, T)) poses[id] = T;
 	}
-	if (m_recorder)
-	{
-		const auto t2 = std::chrono::steady_clock::now();
-		try
-		{
-			noteRunAttributes();
-			m_recorder->finish(m_map, m_loopCloser.get(), m_maps.get());
-		}
-		catch (const std::exception& e)
-		{
-			// The other outputs are still written; the error is reported with them.
-			std::lock_guard<std::mutex> lk(m_statsMutex);
-			if (m_backgroundError.empty()) m_backgroundError = std::string("session store: ") + e.what();
-		}
-		m_timings.add("session_store", secondsSince(t2));
-	}
-	if (!rc.refineFrames) return;
-	const auto t1 = std::chrono::steady_clock::now();
+	if (largestDisplacement(before, poses, rc.mapReanchorDepth) > rc.mapReanchorMinShift)
+		seconds = publishCorrection({PoseCorrection::Source::FinalRefinement, poses, 0}, nullptr);
+	m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
+	return seconds;
+}
+
+void System::refineFrames(const std::optional<std::set<sfm::KeyFrameId>>& window)
+{
+	if (!m_cfg.refinement.refineFrames) return;
+	const auto t0 = std::chrono::steady_clock::now();
 	const sfm::SparseMap& map = m_map;
 	m_refined = refineFramePoses(
 		m_frames, trajectory(), m_map, *m_K, m_cfg.tracker,
@@ -481,7 +506,24 @@ void System::finish()
 			// follow their reference keyframe (trajectory()).
 			return !window || (f.hasReference && window->count(f.reference) > 0);
 		});
-	m_timings.add("frame_refinement", secondsSince(t1));
+	m_timings.add("frame_refinement", secondsSince(t0));
+}
+
+void System::storeFinalSession()
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	try
+	{
+		noteRunAttributes();
+		m_recorder->finish(m_map, m_loopCloser.get(), m_maps.get());
+	}
+	catch (const std::exception& e)
+	{
+		// The other outputs are still written; the error is reported with them.
+		std::lock_guard<std::mutex> lk(m_statsMutex);
+		if (m_backgroundError.empty()) m_backgroundError = std::string("session store: ") + e.what();
+	}
+	m_timings.add("session_store", secondsSince(t0));
 }
 
 core::Trajectory System::trajectory() const

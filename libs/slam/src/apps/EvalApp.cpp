@@ -19,68 +19,90 @@ std::string mergeJson(const std::string& trajectoryJson, const std::string& mapF
 	auto end = trajectoryJson.find_last_not_of(" \n", close - 1);
 	return trajectoryJson.substr(0, end + 1) + ",\n" + mapFields + "\n}\n";
 }
+
+/** keygrid-eval's options and flags. */
+core::CommandLine evalCommandLine()
+{
+	core::CommandLine cl(
+		"keygrid-eval",
+		"Evaluates an estimated TUM trajectory against ground truth: associates poses by\n"
+		"timestamp, aligns positions (SE(3) Horn/Umeyama, or Sim(3) with --sim3), and reports\n"
+		"the absolute trajectory error (ATE) and the relative pose error (RPE) per second.\n"
+		"With --map and --floorplan it also scores keygrid-slam's 2D grid against keygrid-sim's\n"
+		"floor plan, carried into the ground-truth world by the same alignment: hazard cells\n"
+		"(obstacles called free), obstacle recall over the boundary cells the cameras saw,\n"
+		"obstacle precision, free-space F1, the floor estimate's error; --overlay draws the\n"
+		"map over the plan (colours: doc/maps-ism2d.md).");
+	cl.option("gt", "GT.txt", "ground-truth trajectory (TUM format)", true)
+		.option("est", "EST.txt", "estimated trajectory (TUM format)", true)
+		.option("json", "OUT.json", "also write the results as JSON (keys ate_rmse_m, rpe_trans_m_per_s, rpe_rot_deg_per_s, matched, ...; map_* with --map)")
+		.option("max-dt", "SECONDS", "largest timestamp difference for a match", false, "0.02")
+		.option("delta", "SECONDS", "RPE time step", false, "1.0")
+		.option("map", "MAP_2D.yaml", "keygrid-slam's 2D grid (its first line holds the floor pose) to score; needs --floorplan")
+		.option("floorplan", "PLAN.yaml", "keygrid-sim's ground-truth floor plan (floorplan.yaml)")
+		.option("scene", "SCENE.ini", "with --keyframes: render the scene at the keyframes' ground-truth poses to know which cells the cameras saw")
+		.option("keyframes", "KF.txt", "keyframe timestamps (keygrid-slam's keyframes.txt), with --scene")
+		.option("overlay", "OUT.png", "write the map laid over the floor plan (occupied / free / missed / hazard / false obstacle)")
+		.option("tolerance", "M", "occupied cells match within this distance", false, "0.05")
+		.option("max-range", "M", "horizontal range of the cameras' view for --scene", false, "4.5")
+		.option("map-run-gt", "GT1.txt", "with --map-run-est: measure --est in a stored map's frame, fixed by the mapping run's poses (orientations and positions) against this ground truth (localization runs: not re-aligned)")
+		.option("map-run-est", "EST1.txt", "the mapping run's trajectory (keygrid-slam --map), with --map-run-gt")
+		.flag("sim3", "align with scale (for monocular or scale-drifting estimates)")
+		.flag("skip-bad-lines", "skip malformed lines (reported) instead of failing")
+		.flag("quiet", "no progress output");
+	return cl;
+}
+
+/** The alignment and error options (--max-dt, --delta, --sim3), checked. */
+eval::TrajectoryErrorOptions trajectoryErrorOptions(const core::CommandLine& cl)
+{
+	eval::TrajectoryErrorOptions opts;
+	opts.maxDt = cl.getDouble("max-dt");
+	opts.rpeDelta = cl.getDouble("delta");
+	opts.withScale = cl.flagSet("sim3");
+	std::string why;
+	if (!opts.isValid(&why)) throw core::CommandLineError(why);
+	return opts;
+}
+
+/** The map scoring options of --map (which needs --floorplan and an SE(3) alignment); without
+ * --map, its companion options are command-line errors. */
+MapEvaluationOptions mapEvaluationOptions(const core::CommandLine& cl, const eval::TrajectoryErrorOptions& opts)
+{
+	MapEvaluationOptions mo;
+	if (!cl.has("map"))
+	{
+		for (const std::string k : {"floorplan", "scene", "keyframes", "overlay"})
+			if (cl.has(k)) throw core::CommandLineError("--" + k + " needs --map");
+		return mo;
+	}
+	if (!cl.has("floorplan")) throw core::CommandLineError("--map needs --floorplan");
+	if (opts.withScale) throw core::CommandLineError("--map needs an SE(3) alignment: drop --sim3");
+	if (cl.has("scene") != cl.has("keyframes")) throw core::CommandLineError("--scene and --keyframes go together");
+	mo.mapYaml = cl.get("map");
+	mo.floorPlanYaml = cl.get("floorplan");
+	mo.scenePath = cl.has("scene") ? cl.get("scene") : "";
+	mo.keyframesPath = cl.has("keyframes") ? cl.get("keyframes") : "";
+	mo.overlayPath = cl.has("overlay") ? cl.get("overlay") : "";
+	mo.metrics.matchTolerance = cl.getDouble("tolerance");
+	mo.visibility.maxRange = cl.getDouble("max-range");
+	mo.maxDt = opts.maxDt;
+	mo.progress = !cl.flagSet("quiet");
+	std::string why;
+	if (!mo.metrics.isValid(&why)) throw core::CommandLineError("--tolerance: " + why);
+	if (!mo.visibility.isValid(&why)) throw core::CommandLineError("--max-range: " + why);
+	return mo;
+}
 }  // namespace
 
 int EvalApp::run(int argc, const char* const* argv)
 {
 	return runApp("keygrid-eval", [&] {
-		core::CommandLine cl(
-			"keygrid-eval",
-			"Evaluates an estimated TUM trajectory against ground truth: associates poses by\n"
-			"timestamp, aligns positions (SE(3) Horn/Umeyama, or Sim(3) with --sim3), and reports\n"
-			"the absolute trajectory error (ATE) and the relative pose error (RPE) per second.\n"
-			"With --map and --floorplan it also scores keygrid-slam's 2D grid against keygrid-sim's\n"
-			"floor plan, carried into the ground-truth world by the same alignment: hazard cells\n"
-			"(obstacles called free), obstacle recall over the boundary cells the cameras saw,\n"
-			"obstacle precision, free-space F1, the floor estimate's error; --overlay draws the\n"
-			"map over the plan (colours: doc/maps-ism2d.md).");
-		cl.option("gt", "GT.txt", "ground-truth trajectory (TUM format)", true)
-			.option("est", "EST.txt", "estimated trajectory (TUM format)", true)
-			.option("json", "OUT.json", "also write the results as JSON (keys ate_rmse_m, rpe_trans_m_per_s, rpe_rot_deg_per_s, matched, ...; map_* with --map)")
-			.option("max-dt", "SECONDS", "largest timestamp difference for a match", false, "0.02")
-			.option("delta", "SECONDS", "RPE time step", false, "1.0")
-			.option("map", "MAP_2D.yaml", "keygrid-slam's 2D grid (its first line holds the floor pose) to score; needs --floorplan")
-			.option("floorplan", "PLAN.yaml", "keygrid-sim's ground-truth floor plan (floorplan.yaml)")
-			.option("scene", "SCENE.ini", "with --keyframes: render the scene at the keyframes' ground-truth poses to know which cells the cameras saw")
-			.option("keyframes", "KF.txt", "keyframe timestamps (keygrid-slam's keyframes.txt), with --scene")
-			.option("overlay", "OUT.png", "write the map laid over the floor plan (occupied / free / missed / hazard / false obstacle)")
-			.option("tolerance", "M", "occupied cells match within this distance", false, "0.05")
-			.option("max-range", "M", "horizontal range of the cameras' view for --scene", false, "4.5")
-			.option("map-run-gt", "GT1.txt", "with --map-run-est: measure --est in a stored map's frame, fixed by the mapping run's poses (orientations and positions) against this ground truth (localization runs: not re-aligned)")
-			.option("map-run-est", "EST1.txt", "the mapping run's trajectory (keygrid-slam --map), with --map-run-gt")
-			.flag("sim3", "align with scale (for monocular or scale-drifting estimates)")
-			.flag("skip-bad-lines", "skip malformed lines (reported) instead of failing")
-			.flag("quiet", "no progress output");
+		core::CommandLine cl = evalCommandLine();
 		if (!cl.parse(argc, argv)) return 0;
-		eval::TrajectoryErrorOptions opts;
-		opts.maxDt = cl.getDouble("max-dt");
-		opts.rpeDelta = cl.getDouble("delta");
-		opts.withScale = cl.flagSet("sim3");
-		std::string why;
-		if (!opts.isValid(&why)) throw core::CommandLineError(why);
-
+		eval::TrajectoryErrorOptions opts = trajectoryErrorOptions(cl);
 		const bool mapMode = cl.has("map");
-		MapEvaluationOptions mo;
-		if (mapMode)
-		{
-			if (!cl.has("floorplan")) throw core::CommandLineError("--map needs --floorplan");
-			if (opts.withScale) throw core::CommandLineError("--map needs an SE(3) alignment: drop --sim3");
-			if (cl.has("scene") != cl.has("keyframes")) throw core::CommandLineError("--scene and --keyframes go together");
-			mo.mapYaml = cl.get("map");
-			mo.floorPlanYaml = cl.get("floorplan");
-			mo.scenePath = cl.has("scene") ? cl.get("scene") : "";
-			mo.keyframesPath = cl.has("keyframes") ? cl.get("keyframes") : "";
-			mo.overlayPath = cl.has("overlay") ? cl.get("overlay") : "";
-			mo.metrics.matchTolerance = cl.getDouble("tolerance");
-			mo.visibility.maxRange = cl.getDouble("max-range");
-			mo.maxDt = opts.maxDt;
-			mo.progress = !cl.flagSet("quiet");
-			if (!mo.metrics.isValid(&why)) throw core::CommandLineError("--tolerance: " + why);
-			if (!mo.visibility.isValid(&why)) throw core::CommandLineError("--max-range: " + why);
-		}
-		else
-			for (const std::string k : {"floorplan", "scene", "keyframes", "overlay"})
-				if (cl.has(k)) throw core::CommandLineError("--" + k + " needs --map");
+		const MapEvaluationOptions mo = mapEvaluationOptions(cl, opts);
 
 		core::TrajectoryReadOptions ro;
 		ro.skipBadLines = cl.flagSet("skip-bad-lines");

@@ -80,11 +80,9 @@ class DescriptorExtractor
 	cv::Ptr<cv::Feature2D> m_f;
 };
 
-int train(const core::CommandLine& cl)
+/** Training options of the command line (--k, --levels, --seed, --threads), checked. */
+loop::VocabularyOptions vocabularyOptions(const core::CommandLine& cl)
 {
-	const int inputs = cl.has("images") + cl.has("rawlog") + cl.has("tum");
-	if (inputs != 1) throw core::CommandLineError("train needs exactly one of --images, --rawlog, --tum");
-	if (!cl.has("output")) throw core::CommandLineError("missing --output");
 	loop::VocabularyOptions vo;
 	vo.branching = static_cast<int>(cl.getInt("k"));
 	vo.levels = static_cast<int>(cl.getInt("levels"));
@@ -92,6 +90,89 @@ int train(const core::CommandLine& cl)
 	vo.threads = static_cast<int>(cl.getInt("threads"));
 	std::string why;
 	if (!vo.isValid(&why)) throw core::CommandLineError(why);
+	return vo;
+}
+
+/** The descriptors of the training images, one matrix per image, with their count. */
+class TrainingDescriptors
+{
+   public:
+	/** --max-images (0: all) and --every of the command line. */
+	TrainingDescriptors(long maxImages, long every) : m_maxImages(maxImages), m_every(every) {}
+
+	/** Whether the image of this index (0, 1, ... in input order) is one to use. */
+	bool keep(std::size_t index) const { return index % static_cast<std::size_t>(m_every) == 0; }
+	/** Whether --max-images images are collected. */
+	bool full() const { return m_maxImages > 0 && m_perImage.size() >= static_cast<std::size_t>(m_maxImages); }
+	void add(const cv::Mat& d)
+	{
+		m_perImage.push_back(d);
+		m_total += static_cast<std::size_t>(d.rows);
+	}
+	const std::vector<cv::Mat>& perImage() const { return m_perImage; }
+	std::size_t total() const { return m_total; }
+
+   private:
+	long m_maxImages, m_every;
+	std::vector<cv::Mat> m_perImage;
+	std::size_t m_total{0};
+};
+
+/** --images: the descriptors of a folder of images or of an image list. */
+void collectFromImages(const std::string& where, const DescriptorExtractor& extract, TrainingDescriptors& descriptors)
+{
+	const auto paths = imagePaths(where);
+	core::ProgressBar bar("extracting", paths.size());
+	for (std::size_t i = 0; i < paths.size() && !descriptors.full(); ++i)
+	{
+		if (!descriptors.keep(i)) continue;
+		const cv::Mat img = cv::imread(paths[i], cv::IMREAD_GRAYSCALE);
+		if (img.empty()) throw std::runtime_error("cannot read image " + paths[i]);
+		descriptors.add(extract(img));
+		bar.update(i + 1, std::to_string(descriptors.total()) + " descriptors");
+	}
+	bar.finish(std::to_string(descriptors.total()) + " descriptors");
+}
+
+/** --rawlog / --tum: the descriptors of the grey images of a recorded sequence. */
+void collectFromSequence(const core::CommandLine& cl, const DescriptorExtractor& extract, TrainingDescriptors& descriptors)
+{
+	const std::string path = cl.has("rawlog") ? cl.get("rawlog") : cl.get("tum");
+	if (cl.has("tum") && !fs::is_directory(path)) throw std::runtime_error("--tum " + path + " is not a folder");
+	if (cl.has("rawlog") && !fs::is_regular_file(path)) throw std::runtime_error("--rawlog " + path + " is not a file");
+	auto src = core::openFrameSource(path);
+	core::ProgressBar bar("extracting", src->sizeHint().value_or(0));
+	core::Frame f;
+	std::size_t index = 0;
+	while (!descriptors.full() && src->next(f))
+	{
+		if (descriptors.keep(index++) && !f.grey.empty()) descriptors.add(extract(f.grey));
+		bar.update(index, std::to_string(descriptors.total()) + " descriptors");
+	}
+	bar.finish(std::to_string(descriptors.total()) + " descriptors");
+}
+
+/** Number of images with features; throws unless there are at least 2: idf = log(images /
+ * images with the word), so with one image every word has weight 0 and every place would
+ * score alike. */
+long imagesWithFeatures(const TrainingDescriptors& descriptors)
+{
+	if (descriptors.total() == 0) throw std::runtime_error("no descriptors extracted (no images or no texture)");
+	const auto& d = descriptors.perImage();
+	const auto withFeatures = std::count_if(d.begin(), d.end(), [](const cv::Mat& m) { return m.rows > 0; });
+	if (withFeatures < 2)
+		throw std::runtime_error(
+			"training needs at least 2 images with features, got " + std::to_string(withFeatures) +
+			" (with one, every word is in every image and weighs 0)");
+	return static_cast<long>(withFeatures);
+}
+
+int train(const core::CommandLine& cl)
+{
+	const int inputs = cl.has("images") + cl.has("rawlog") + cl.has("tum");
+	if (inputs != 1) throw core::CommandLineError("train needs exactly one of --images, --rawlog, --tum");
+	if (!cl.has("output")) throw core::CommandLineError("missing --output");
+	const loop::VocabularyOptions vo = vocabularyOptions(cl);
 	const long maxImages = cl.getInt("max-images");
 	const long every = cl.getInt("every");
 	const long features = cl.getInt("nfeatures");
@@ -100,55 +181,15 @@ int train(const core::CommandLine& cl)
 	if (features < 1) throw core::CommandLineError("--nfeatures " + cl.get("nfeatures") + " (must be >= 1)");
 	const DescriptorExtractor extract(cl.get("features"), static_cast<int>(features));
 
-	std::vector<cv::Mat> descriptors;
-	std::size_t total = 0;
-	auto keep = [&](std::size_t index) { return index % static_cast<std::size_t>(every) == 0; };
-	auto full = [&] { return maxImages > 0 && descriptors.size() >= static_cast<std::size_t>(maxImages); };
-	auto add = [&](const cv::Mat& d) {
-		descriptors.push_back(d);
-		total += static_cast<std::size_t>(d.rows);
-	};
+	TrainingDescriptors descriptors(maxImages, every);
 	if (cl.has("images"))
-	{
-		const auto paths = imagePaths(cl.get("images"));
-		core::ProgressBar bar("extracting", paths.size());
-		for (std::size_t i = 0; i < paths.size() && !full(); ++i)
-		{
-			if (!keep(i)) continue;
-			const cv::Mat img = cv::imread(paths[i], cv::IMREAD_GRAYSCALE);
-			if (img.empty()) throw std::runtime_error("cannot read image " + paths[i]);
-			add(extract(img));
-			bar.update(i + 1, std::to_string(total) + " descriptors");
-		}
-		bar.finish(std::to_string(total) + " descriptors");
-	}
+		collectFromImages(cl.get("images"), extract, descriptors);
 	else
-	{
-		const std::string path = cl.has("rawlog") ? cl.get("rawlog") : cl.get("tum");
-		if (cl.has("tum") && !fs::is_directory(path)) throw std::runtime_error("--tum " + path + " is not a folder");
-		if (cl.has("rawlog") && !fs::is_regular_file(path)) throw std::runtime_error("--rawlog " + path + " is not a file");
-		auto src = core::openFrameSource(path);
-		core::ProgressBar bar("extracting", src->sizeHint().value_or(0));
-		core::Frame f;
-		std::size_t index = 0;
-		while (!full() && src->next(f))
-		{
-			if (keep(index++) && !f.grey.empty()) add(extract(f.grey));
-			bar.update(index, std::to_string(total) + " descriptors");
-		}
-		bar.finish(std::to_string(total) + " descriptors");
-	}
-	if (total == 0) throw std::runtime_error("no descriptors extracted (no images or no texture)");
-	// idf = log(images / images with the word): with one image every word has weight 0 and
-	// every place would score alike.
-	const auto withFeatures = std::count_if(descriptors.begin(), descriptors.end(), [](const cv::Mat& d) { return d.rows > 0; });
-	if (withFeatures < 2)
-		throw std::runtime_error(
-			"training needs at least 2 images with features, got " + std::to_string(withFeatures) +
-			" (with one, every word is in every image and weighs 0)");
+		collectFromSequence(cl, extract, descriptors);
+	const long withFeatures = imagesWithFeatures(descriptors);
 
-	core::ProgressBar bar("clustering", total);
-	const loop::Vocabulary v = loop::Vocabulary::train(descriptors, vo, [&](std::size_t done, std::size_t) { bar.update(done); });
+	core::ProgressBar bar("clustering", descriptors.total());
+	const loop::Vocabulary v = loop::Vocabulary::train(descriptors.perImage(), vo, [&](std::size_t done, std::size_t) { bar.update(done); });
 	bar.finish();
 	bool anyWeight = false;
 	for (std::size_t w = 0; w < v.numWords() && !anyWeight; ++w) anyWeight = v.idf(static_cast<loop::WordId>(w)) > 0;
@@ -160,7 +201,7 @@ int train(const core::CommandLine& cl)
 	v.save(os);
 	core::writeFileAtomically(cl.get("output"), os.str());
 	std::cout << v.describe() << "\n"
-			  << "trained on " << total << " descriptors in " << std::fixed << std::setprecision(1) << bar.elapsed()
+			  << "trained on " << descriptors.total() << " descriptors in " << std::fixed << std::setprecision(1) << bar.elapsed()
 			  << " s -> " << cl.get("output") << " (" << os.str().size() / 1024 << " KiB)\n";
 	return 0;
 }

@@ -16,10 +16,14 @@
  *    pixels whose voxel (insertion `point_spacing`) holds no point yet become new points (+1),
  *    and points whose largest bin weight is below prune_threshold are removed.
  *    tol = occlusion_tolerance_abs + occlusion_tolerance_rel * z.
+ *
+ * In a SLAM run (maps::KeyFrameMap, CHOCPointsMap_keyframes.cpp) the map follows the
+ * frontend's landmarks (syncLandmarks) and takes nothing from keyframes or corrections itself.
  */
 #include <keygrid/maps/ExportFrame.h>
 #include <keygrid/maps/HocGeometry.h>
 #include <keygrid/maps/HocHistogram.h>
+#include <keygrid/maps/KeyFrameMap.h>
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/CMetricMap.h>
 #include <mrpt/math/TPoint3D.h>
@@ -33,7 +37,7 @@
 
 namespace keygrid
 {
-class CHOCPointsMap : public mrpt::maps::CMetricMap
+class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 {
 	DEFINE_SERIALIZABLE(CHOCPointsMap, keygrid)
 
@@ -111,6 +115,28 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap
 	 * `observations` (sum of positive counts). Throws std::runtime_error if not writable.
 	 * Points are mapped into `frame` (e.g. the floor frame); frame.comment is a PLY comment. */
 	void saveAsPly(const std::string& path, const maps::ExportFrame& frame = {}) const;
+
+	/** @name In a SLAM run (maps::KeyFrameMap)
+	 * @{ */
+	/** The frontend decides what a keyframe adds: its landmarks come with syncLandmarks(). */
+	void insertKeyFrame(const maps::MapKeyFrame&, const maps::KeyFrameFeed&) override {}
+	/** Becomes `landmarks()` (points and hocOptions, the frontend's descriptor options, so the
+	 * histograms keep their meaning), keeping its own insertion, likelihood and render
+	 * options. */
+	void syncLandmarks(const maps::LandmarkSource& landmarks) override;
+	/** The landmarks are corrected by the frontend and come back with syncLandmarks().
+	 * Returns false. */
+	bool applyCorrection(const maps::MapCorrection&) override { return false; }
+	/** The map has no mapping mode a loop closure would change. */
+	void notifyLoopClosure() override {}
+	/** The points stay in the SLAM world; the PLY export takes the frame it is written in. */
+	void setFloorFrame(const std::optional<mrpt::poses::CPose3D>&) override {}
+	/** hoc_points<suffix>.ply (saveAsPly, in out.frame()) and .bin (this map serialized,
+	 * gz-compressed, in the SLAM world). */
+	void writeOutputs(maps::MapOutputFolder& out, const std::string& suffix) const override;
+	/** "points". */
+	std::string summaryJsonFields() const override;
+	/** @} */
 
 	// CMetricMap / Stringifyable / Visualizable
 	bool isEmpty() const override { return m_points.empty(); }

@@ -5,6 +5,7 @@
  */
 #include <keygrid/maps/FloorPlaneEstimator.h>
 #include <keygrid/maps/InverseSensorModel.h>
+#include <keygrid/maps/KeyFrameMap.h>
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/CMetricMap.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
@@ -54,8 +55,11 @@ enum class CellState : uint8_t
  * and insertObservation(CObservation3DRangeScan) (dense depth, reduced to one ray per endpoint
  * cell). Each keyframe's rays are kept in the camera frame, so applyTrajectoryCorrection()
  * rebuilds the grid under corrected poses after a loop closure.
+ *
+ * In a SLAM run (maps::KeyFrameMap, CISMOccupancyGrid2D_keyframes.cpp) the grid takes the
+ * run's floor frame, its keyframes' map points or depth, and rebuilds on corrections.
  */
-class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
+class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 {
 	DEFINE_SERIALIZABLE(CISMOccupancyGrid2D, keygrid)
 
@@ -239,6 +243,33 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	bool externalFloor() const { return m_floorExternal; }
 	/** @} */
 
+	/** @name In a SLAM run (maps::KeyFrameMap)
+	 * @{ */
+	/** GridInput::Depth and a keyframe with depth: insertKeyframeDepth(), after the keyframes
+	 * kept aside until the floor frame was known (the depth is reduced in the floor frame);
+	 * otherwise insertKeyframePoints() with its map points (stored also before the floor is
+	 * known, integrated then). */
+	void insertKeyFrame(const maps::MapKeyFrame& kf, const maps::KeyFrameFeed& feed) override;
+	/** The grid reads a keyframe's own map points at insertion, not the landmark set. */
+	void syncLandmarks(const maps::LandmarkSource&) override {}
+	/** Takes correction.T_world_floor when given, then rebuilds under the corrected poses of
+	 * its keyframes (applyTrajectoryCorrection()); false while the floor frame is unknown
+	 * (nothing integrated yet). */
+	bool applyCorrection(const maps::MapCorrection& correction) override;
+	/** The 2D grid has no mapping mode a loop closure would change. */
+	void notifyLoopClosure() override {}
+	/** The run's floor frame becomes the grid's (setExternalFloorPose(); nullopt:
+	 * expectExternalFloorPose()) and the keyframes integrated so far are integrated again in
+	 * it. The first call refuses a floor of the grid's own (insertionOptions.T_world_floor
+	 * without estimateFloorFromDepth), naming the INI key. */
+	void setFloorFrame(const std::optional<mrpt::poses::CPose3D>& T_world_floor) override;
+	/** map_2d<suffix>.yaml + .pgm (saveAsRosMapServer), .png (saveAsImage) and .bin (this map
+	 * serialized, gz-compressed), all in the grid's floor frame. */
+	void writeOutputs(maps::MapOutputFolder& out, const std::string& suffix) const override;
+	/** "cells", "states" (countStates()) and "keyframes". */
+	std::string summaryJsonFields() const override;
+	/** @} */
+
 	/** @name Cell access (cell indices; (0,0) is the cell at (xMin, yMin))
 	 * @{ */
 	double resolution() const { return m_resolution; }
@@ -314,6 +345,11 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	/** The floor is set from outside (setExternalFloorPose) into m_T_world_floorEstimate. */
 	bool m_floorExternal{false};
 	std::map<uint64_t, KeyframeRays> m_keyframes;
+	/** insertKeyFrame() with depth input: keyframes that arrived before the floor frame. */
+	std::vector<uint64_t> m_waitingForFloor;
+	/** INI section prefix the grid was created from (`<sect>_ismOccupancyGrid2D_NN`), to name
+	 * keys in errors; empty when built in code. */
+	std::string m_optionSection;
 	uint64_t m_nextAutoKeyframeId{1ULL << 62};  ///< ids for insertObservation() inputs
 	double m_lastRebuildSeconds{0};
 	/** Per-insertion scratch: the one update each cell (heightBand: each slice) gets from the
@@ -350,6 +386,8 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap
 	TCreationOptions creationOpts;
 	TInsertionOptions insertionOpts;
 	TLikelihoodOptions likelihoodOpts;
+	/** The INI section prefix the options were read from */
+	std::string optionSection;
 	MAP_DEFINITION_END(CISMOccupancyGrid2D)
 };
 

@@ -17,6 +17,9 @@
  * register.cpp. insertObservation() accepts CObservation3DRangeScan (each one a keyframe with
  * an automatic id, travelled distance accumulated from the poses).
  *
+ * In a SLAM run (maps::KeyFrameMap, CSubmappedOccupancyGrid3D_keyframes.cpp) the grid takes
+ * each keyframe's depth with the camera's path length and is morphed on corrections.
+ *
  * Threading: call one map from one thread at a time; integration and morphing use their own
  * worker threads (options `threads`, `morphThreads`) and give the same result for any count.
  * Documentation and measurements: doc/maps-3d.md.
@@ -26,6 +29,7 @@
 #include <keygrid/maps/DepthFrameIntegrator.h>
 #include <keygrid/maps/ExportFrame.h>
 #include <keygrid/maps/GridMorphing.h>
+#include <keygrid/maps/KeyFrameMap.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
 #include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/CMetricMap.h>
@@ -41,7 +45,7 @@
 
 namespace keygrid
 {
-class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap
+class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 {
 	DEFINE_SERIALIZABLE(CSubmappedOccupancyGrid3D, keygrid)
 
@@ -146,7 +150,7 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap
 		const mrpt::poses::CPose3D& T_world_cam, double travelled,
 		std::optional<uint64_t> keyframeId);
 	/** Signals a loop closure: the next frame is integrated in localization mode. */
-	void notifyLoopClosure() { m_modeMachine.notifyRevisit(); }
+	void notifyLoopClosure() override { m_modeMachine.notifyRevisit(); }
 	/** Signals a relocalization: same effect as a loop closure. */
 	void notifyRelocalization() { m_modeMachine.notifyRevisit(); }
 	MappingMode mode() const { return m_modeMachine.mode(); }
@@ -186,6 +190,25 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap
 	 * corrected pose. Requires insertionOptions.storeKeyframeDepth (throws std::logic_error
 	 * naming the first keyframe without depth otherwise). */
 	ReintegrationStats reintegrateAtCorrectedPoses(const TrajectoryCorrection& corr);
+	/** @} */
+
+	/** @name In a SLAM run (maps::KeyFrameMap)
+	 * @{ */
+	/** insertDepthFrame() of the keyframe's depth at its pose and path length; nothing
+	 * without depth. */
+	void insertKeyFrame(const maps::MapKeyFrame& kf, const maps::KeyFrameFeed& feed) override;
+	/** The grid is made of depth, not of the frontend's landmarks. */
+	void syncLandmarks(const maps::LandmarkSource&) override {}
+	/** morphAndMergeSubmaps(correction.poses); always true. */
+	bool applyCorrection(const maps::MapCorrection& correction) override;
+	// notifyLoopClosure(): see Integration.
+	/** The grid stays in the SLAM world; its exports take the frame they are written in. */
+	void setFloorFrame(const std::optional<mrpt::poses::CPose3D>&) override {}
+	/** map_3d<suffix>.bt (saveAsOctomapBinary) and .ply (saveOccupiedAsPly), in out.frame(),
+	 * and .bin (this map serialized, gz-compressed, in the SLAM world). */
+	void writeOutputs(maps::MapOutputFolder& out, const std::string& suffix) const override;
+	/** "submaps", "memory_bytes" (memoryBytes()) and "keyframes". */
+	std::string summaryJsonFields() const override;
 	/** @} */
 
 	/** @name Exports

@@ -1,7 +1,8 @@
 #pragma once
 /** \file PoseOptimizer.h
- * Pose-only refinement of one camera against fixed 3D landmarks (Ceres, Huber loss,
- * reprojection + depth residuals), with ORB-SLAM2-style rounds of outlier classification.
+ * Pose-only refinement of one camera against fixed 3D landmarks (reprojection + depth
+ * residuals, Huber loss), with ORB-SLAM2-style rounds of outlier classification; each round is
+ * solved by the dedicated Levenberg-Marquardt solver of PoseLevenbergMarquardt.h.
  */
 #include <keygrid/sfm/RgbdReprojectionCost.h>
 #include <mrpt/poses/CPose3D.h>

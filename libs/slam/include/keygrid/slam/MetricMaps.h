@@ -5,25 +5,32 @@
  * `MappingApplication_ismOccupancyGrid2D_00_creationOpts`, ...), so keygrid's plugins and MRPT's
  * own maps (octoMap, occupancyGrid, pointsMap, ...) run side by side.
  *
- * keygrid's maps get what they were designed for (the 2D ISM grid a keyframe's map points or
- * depth, the submapped 3D grid the depth with the travelled distance); other maps get the
- * keyframe as a CObservation3DRangeScan at its pose.
+ * Every map is held as a maps::KeyFrameMap (one dynamic_cast when the maps are created):
+ * keygrid's plugins implement it themselves and get what they were designed for (the 2D ISM
+ * grid a keyframe's map points or depth, the submapped 3D grid the depth with the travelled
+ * distance, the HOC map the frontend's landmarks); MRPT's own maps join through
+ * maps::ObservationFedMap and get the keyframe as a CObservation3DRangeScan at its pose.
+ * MetricMaps builds each event once (maps::MapKeyFrame, maps::MapCorrection, ...) and hands it
+ * to every map.
  *
  * The floor frame: MetricMaps owns the run's one floor estimate (maps::FloorFrameEstimator,
  * INI section [floor]), fed with every keyframe whether or not a 2D grid is configured. Every
- * 2D grid takes it as its floor (CISMOccupancyGrid2D::setExternalFloorPose) and is
- * re-integrated when it changes; map_3d.bt/.ply and hoc_points.ply are written in it. The
+ * map takes it (maps::KeyFrameMap::setFloorFrame: every 2D grid as its floor, re-integrated
+ * when it changes); map_3d.bt/.ply and hoc_points.ply are written in it. The
  * maps themselves (and their serialized .bin files) stay in the SLAM world, where loop
  * closures re-anchor them.
  */
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CHOCPointsMap.h>
 #include <keygrid/maps/FloorFrameEstimator.h>
+#include <keygrid/maps/KeyFrameMap.h>
+#include <keygrid/maps/ObservationFedMap.h>
 #include <keygrid/sfm/SparseMap.h>
 #include <keygrid/slam/KeyFrameImageSource.h>
 #include <mrpt/maps/CMultiMetricMap.h>
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -61,6 +68,12 @@ class MetricMaps
 	static MetricMaps FromMaps(
 		const std::vector<mrpt::maps::CMetricMap::Ptr>& maps, const std::optional<mrpt::poses::CPose3D>& T_world_floor);
 
+	/** Holds pointers into its own maps: movable, not copyable. */
+	MetricMaps(MetricMaps&&) = default;
+	MetricMaps& operator=(MetricMaps&&) = default;
+	MetricMaps(const MetricMaps&) = delete;
+	MetricMaps& operator=(const MetricMaps&) = delete;
+
 	bool empty() const { return m_maps.maps.empty(); }
 	std::size_t size() const { return m_maps.maps.size(); }
 	const mrpt::maps::CMultiMetricMap& maps() const { return m_maps; }
@@ -81,7 +94,7 @@ class MetricMaps
 	/** Re-anchors the maps on corrected keyframe poses (kf id -> new T_world_cam): the floor
 	 * is re-estimated under them, the 2D grid is rebuilt from its stored keyframe
 	 * observations, the 3D grid morphed and merged.
-	 * Returns seconds spent per map name. */
+	 * Returns seconds spent per map name ("floor" and each map that re-anchored). */
 	std::map<std::string, double> applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses);
 
 	/** Copies the frontend's landmarks (positions, descriptors, histograms) into every
@@ -107,19 +120,26 @@ class MetricMaps
 	MetricMaps(const MapFeedOptions& feed, const maps::FloorFrameOptions& floor) : m_feed(feed), m_floor(floor) {}
 
 	mrpt::maps::CMultiMetricMap m_maps;
+	/** m_maps.maps[i] as a keyframe map: the map itself for keygrid's plugins, an entry of
+	 * m_observationFedMaps for MRPT's own. Same order as m_maps.maps. */
+	std::vector<maps::KeyFrameMap*> m_keyFrameMaps;
+	std::vector<std::unique_ptr<maps::ObservationFedMap>> m_observationFedMaps;
 	MapFeedOptions m_feed;
+	/** Per inserted keyframe: the pose the maps hold it at (updated by corrections). */
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> m_insertedPoses;
+	/** Per inserted keyframe: the camera's path length at it [m]. */
+	std::map<sfm::KeyFrameId, double> m_travelled;
 	maps::FloorFrameEstimator m_floor;
 	/** FromMaps(): the floor frame of the run that built the maps */
 	std::optional<mrpt::poses::CPose3D> m_restoredFloor;
-	/** Dense 2D input, per map index: keyframes that arrived before the floor was known. */
-	std::map<std::size_t, std::vector<sfm::KeyFrameId>> m_pendingDense;
 
 	const KeyFrameImageSource* m_images{nullptr};
+	/** Fills m_keyFrameMaps from m_maps (one dynamic_cast per map). */
+	void listKeyFrameMaps();
+	/** Keyframe `id` as the maps take it, as it is now in `map`. */
+	maps::MapKeyFrame mapKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, double travelled) const;
 	/** The keyframe's depth, from m_images when the keyframe dropped it. */
 	cv::Mat depthOf(const sfm::KeyFrame& kf) const;
-	/** Hands a new floor frame to every 2D grid and re-integrates those that hold keyframes. */
-	void floorChanged();
 	/** The frame map outputs are written in: the floor frame, else the SLAM world. */
 	maps::ExportFrame outputFrame() const;
 };

@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -80,6 +81,11 @@ class SessionRecorder
 	/** After a keyframe went through local mapping and loop closing (map lock held): writes
 	 * what changed. `loop` may be null (no loop closing); `maps` may be null (no metric maps). */
 	void afterKeyFrame(const sfm::SparseMap& map, const LoopCloser* loop, const LoopClosureEvent* closed, const MetricMaps* maps);
+	/** Whether the next afterKeyFrame() with metric maps stores their snapshots. */
+	bool snapshotDueAtNextKeyFrame() const
+	{
+		return m_opts.snapshotEvery > 0 && m_keyframesSinceSnapshot + 1 >= static_cast<std::size_t>(m_opts.snapshotEvery);
+	}
 	/** After the final refinement: the last changes and the map snapshots, then waits for the
 	 * writer and closes the file. Throws std::runtime_error naming the file on a write error. */
 	void finish(const sfm::SparseMap& map, const LoopCloser* loop, const MetricMaps* maps);
@@ -116,6 +122,17 @@ class SessionRecorder
 	/** The changes since the last update (and records what is written now). withCounters:
 	 * also landmarks whose only change is in their visibility counters or HOC histogram. */
 	store::SessionWriteJob diff(const sfm::SparseMap& map, const LoopCloser* loop, bool withCounters);
+	/** Keyframes of diff(): new ones whole (with images), moved ones as poses, changed
+	 * covisibility as edges (weight 0: removed), erased ones by id. */
+	void diffKeyFrames(const sfm::SparseMap& map, const LoopCloser* loop, store::SessionWriteJob& job);
+	/** A keyframe not written yet: its record (with its BoW vector), images and covisibility. */
+	void addNewKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, const LoopCloser* loop, store::SessionWriteJob& job);
+	/** A keyframe written before: its pose and covisibility changes into `u` and `written`. */
+	void diffWrittenKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, WrittenKeyFrame& written, store::SessionUpdate& u);
+	/** Landmarks of diff(): written when any field changed, erased ones by id. Returns the
+	 * keyframes observing them (before and now), whose keypoint -> landmark association is to
+	 * be rewritten. */
+	std::set<sfm::KeyFrameId> diffLandmarks(const sfm::SparseMap& map, bool withCounters, store::SessionUpdate& u);
 	void addSnapshots(store::SessionUpdate& u, const sfm::SparseMap& map, const MetricMaps& maps);
 
 	std::string m_path;

@@ -27,9 +27,11 @@
 #include <keygrid/core/BoundedQueue.h>
 
 #include <condition_variable>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -172,6 +174,36 @@ class System
 	void startExtending(const sfm::TrackedFrame& tf);
 	/** Hands the recorder what a later localization in the session needs from this run. */
 	void noteRunAttributes();
+	/** finish(): the final bundle adjustment ([refinement]); the keyframes it moved when it
+	 * was bounded, nullopt when it moved every one (or did not run). */
+	std::optional<std::set<sfm::KeyFrameId>> adjustFinalMap();
+	/** finish(): the metric maps re-anchored on the adjusted keyframes (`before`: their poses
+	 * before the adjustment) and the landmarks synced; seconds per map stage. Reads the
+	 * map only, so it may run beside refineFrames(). */
+	std::map<std::string, double> reanchorMaps(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& before);
+	/** finish(): every frame re-estimated against the adjusted map (see refineFramePoses). */
+	void refineFrames(const std::optional<std::set<sfm::KeyFrameId>>& window);
+	/** finish(): the session store's final records; an error is kept as the background error. */
+	void storeFinalSession();
+	/** A correction of keyframe poses, as every part that holds poses follows it. */
+	struct PoseCorrection
+	{
+		enum class Source
+		{
+			LoopClosure,  //!< during the run: the tracker and the frame being tracked follow too
+			FinalRefinement  //!< in finish(): only the maps (the run is over)
+		};
+		Source source;
+		/** Corrected poses of the keyframes that moved */
+		const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses;
+		/** LoopClosure: the keyframe that closed the loop (created by the frame being tracked) */
+		sfm::KeyFrameId keyframe;
+	};
+	/** The one place a correction goes out: the map's correction count and the tracker (loop
+	 * closures), the frame `tf` that created the keyframe (sequential mode, else null), the
+	 * metric maps (re-anchored; told of a loop closure). Frames follow their reference
+	 * keyframes by themselves (trajectory()). Returns seconds per map stage. Map lock held. */
+	std::map<std::string, double> publishCorrection(const PoseCorrection& c, sfm::TrackedFrame* tf);
 	/** Loop detection and correction of a keyframe (map lock held); the event when one closed. */
 	std::optional<LoopClosureEvent> closeLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
 	void mappingThread();

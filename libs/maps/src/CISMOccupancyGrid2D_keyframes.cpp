@@ -1,0 +1,82 @@
+/** \file CISMOccupancyGrid2D_keyframes.cpp
+ * CISMOccupancyGrid2D in a SLAM run (maps::KeyFrameMap): keyframe input, the run's floor
+ * frame, corrections, outputs and summary.
+ */
+#include <keygrid/core/AtomicOutput.h>
+#include <keygrid/maps/CISMOccupancyGrid2D.h>
+
+#include <sstream>
+#include <stdexcept>
+
+namespace keygrid
+{
+void CISMOccupancyGrid2D::insertKeyFrame(const maps::MapKeyFrame& kf, const maps::KeyFrameFeed& feed)
+{
+	if (feed.gridInput == maps::GridInput::Depth && !kf.depth.empty())
+	{
+		// Dense input is reduced in the floor frame: it waits for the floor.
+		if (!floorKnown())
+		{
+			m_waitingForFloor.push_back(kf.id);
+			return;
+		}
+		for (uint64_t id : m_waitingForFloor)
+			if (const auto earlier = feed.keyFrame(id)) insertKeyframeDepth(id, earlier->T_world_cam, earlier->depthScan());
+		m_waitingForFloor.clear();
+		insertKeyframeDepth(kf.id, kf.T_world_cam, kf.depthScan());
+		return;
+	}
+	// Sparse input is stored also before the floor is known, and integrated then.
+	insertKeyframePoints(kf.id, kf.T_world_cam, kf.points_world);
+}
+
+bool CISMOccupancyGrid2D::applyCorrection(const maps::MapCorrection& correction)
+{
+	if (correction.T_world_floor) setExternalFloorPose(*correction.T_world_floor);
+	if (!floorKnown()) return false;  // nothing integrated yet: no floor frame
+	std::map<uint64_t, mrpt::poses::CPose3D> newPoses;
+	for (const auto& [id, c] : correction.poses)
+		if (m_keyframes.count(id)) newPoses[id] = c.T_world_cam_new;
+	applyTrajectoryCorrection(newPoses);
+	return true;
+}
+
+void CISMOccupancyGrid2D::setFloorFrame(const std::optional<mrpt::poses::CPose3D>& T_world_floor)
+{
+	// A floor pose of the grid's own would be silently replaced: refused, naming where the
+	// floor of a SLAM run is given.
+	const auto& io = insertionOptions;
+	if (!m_floorExternal && !io.estimateFloorFromDepth && !maps::ExportFrame{io.T_world_floor, {}}.isIdentity())
+		throw std::invalid_argument(
+			"[" + (m_optionSection.empty() ? std::string("ismOccupancyGrid2D") : m_optionSection) +
+			"_insertOpts] T_world_floor: keygrid-slam gives every map the run's one floor frame; set it as "
+			"[floor] T_world_floor instead");
+	if (!T_world_floor)
+	{
+		expectExternalFloorPose();
+		return;
+	}
+	setExternalFloorPose(*T_world_floor);
+	// The keyframes integrated so far, again in the new floor frame (cheap).
+	if (!m_keyframes.empty()) applyTrajectoryCorrection({});
+}
+
+void CISMOccupancyGrid2D::writeOutputs(maps::MapOutputFolder& out, const std::string& suffix) const
+{
+	const std::string stem = "map_2d" + suffix;
+	// Each file appears atomically; the .pgm is written first, beside the .yaml.
+	if (out.write(stem + ".yaml", [&](const std::string& p) { saveAsRosMapServer(p); })) out.noteWritten(stem + ".pgm");
+	out.write(stem + ".png", [&](const std::string& p) { saveAsImage(p); });
+	out.write(stem + ".bin", [&](const std::string& p) { core::saveGzAtomically(*this, p); });
+}
+
+std::string CISMOccupancyGrid2D::summaryJsonFields() const
+{
+	const auto c = countStates();
+	std::ostringstream o;
+	o << "\"cells\": " << sizeX() * sizeY() << ", \"states\": [" << c[0] << ", " << c[1] << ", " << c[2]
+	  << "], \"keyframes\": " << m_keyframes.size();
+	return o.str();
+}
+
+}  // namespace keygrid

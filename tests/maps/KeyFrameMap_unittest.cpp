@@ -1,0 +1,180 @@
+/** maps::KeyFrameMap driven directly, as slam::MetricMaps drives it: a keyframe's map point
+ * marks the 2D grid along the closed-form ISM and a correction moves the marks with the
+ * keyframe; depth keyframes wait for the run's floor frame and are then taken as they are
+ * now; a grid's own floor pose is refused; outputs are tried one by one. */
+#include <keygrid/maps/CISMOccupancyGrid2D.h>
+#include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
+#include <keygrid/maps/InverseSensorModel.h>
+#include <keygrid/maps/KeyFrameMap.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <vector>
+
+#include "ISMSyntheticRoom.h"
+
+using keygrid::CellState;
+using keygrid::CISMOccupancyGrid2D;
+using mrpt::math::TPoint3D;
+using mrpt::poses::CPose3D;
+namespace maps = keygrid::maps;
+
+namespace
+{
+/** Camera at (x, y, 0.5) looking along +x; y = 0.025: cell centres on the ray are at r = 0.05 k. */
+CPose3D levelCameraAt(double x, double y = 0.025) { return keygrid::test::SyntheticRoom().cameraPose(x, y, 0.5, 0.0, 0.0); }
+
+/** A 2D grid in the paper's free-space model with constant range noise, floor z = 0. */
+CISMOccupancyGrid2D paperGrid()
+{
+	CISMOccupancyGrid2D grid;  // 5 cm, -5..5 m
+	grid.insertionOptions.freeSpaceModel = CISMOccupancyGrid2D::FreeSpaceModel::Paper;
+	grid.insertionOptions.rangeNoise = maps::RangeNoiseModel::Constant;
+	grid.insertionOptions.sigmaConstant = 0.02;
+	return grid;
+}
+
+/** A 64x48 keyframe facing a flat wall `wallDistance` ahead (depth constant along z). */
+maps::MapKeyFrame wallKeyFrame(uint64_t id, const CPose3D& T_world_cam, float wallDistance)
+{
+	maps::MapKeyFrame kf;
+	kf.id = id;
+	kf.T_world_cam = T_world_cam;
+	kf.camera.width = 64;
+	kf.camera.height = 48;
+	kf.camera.fx = kf.camera.fy = 50.0;
+	kf.camera.cx = 31.5;
+	kf.camera.cy = 23.5;
+	kf.depth = cv::Mat(48, 64, CV_32F, cv::Scalar(wallDistance));
+	return kf;
+}
+}  // namespace
+
+/* One keyframe with one map point 1 m ahead: every cell on the ray holds the closed-form ISM
+ * update logit(practicalIsm(r, 1 m)). Corrected 0.5 m forward, the grid is rebuilt with the
+ * point moving with its keyframe: the same profile, 10 cells on. */
+TEST(KeyFrameMap, MapPointMarksTheRayAndACorrectionMovesIt)
+{
+	CISMOccupancyGrid2D grid = paperGrid();
+	maps::KeyFrameMap& map = grid;
+	map.setFloorFrame(CPose3D());
+	const auto shape = grid.insertionOptions.ismShape(grid.resolution());
+	const double z = 1.0, sigma = 0.02;
+	const int cy = grid.y2idx(0.025), c0 = grid.x2idx(0.025);
+
+	maps::MapKeyFrame kf;
+	kf.id = 7;
+	kf.T_world_cam = levelCameraAt(0.025);
+	kf.points_world = {TPoint3D(0.025 + z, 0.025, 0.5)};
+	map.insertKeyFrame(kf, maps::KeyFrameFeed{});
+	ASSERT_EQ(grid.keyframes().size(), 1u);
+
+	auto expectProfileFrom = [&](int first) {
+		for (int i = 0; i < 30; i++)
+		{
+			const double r = 0.05 * i;
+			double l = maps::logit(maps::practicalIsm(r, z, sigma, shape));
+			if (r > z + 0.5 * shape.bandWidth + 8 * sigma) l = 0;  // beyond the traced reach
+			EXPECT_NEAR(grid.logOdds(first + i, cy), l, 2e-5) << "cell " << i << " (r = " << r << ")";
+		}
+	};
+	expectProfileFrom(c0);
+	EXPECT_EQ(grid.cellState(c0 + 20, cy), CellState::Occupied);
+	EXPECT_EQ(grid.cellState(c0 + 10, cy), CellState::Free);
+
+	maps::MapCorrection correction;
+	correction.poses[7] = {kf.T_world_cam, levelCameraAt(0.525)};
+	correction.poses[99] = {CPose3D(), CPose3D(1, 0, 0, 0, 0, 0)};  // not in this grid: ignored
+	EXPECT_TRUE(map.applyCorrection(correction));
+	expectProfileFrom(c0 + 10);
+	EXPECT_EQ(grid.cellState(c0 + 30, cy), CellState::Occupied);
+	EXPECT_EQ(grid.cellState(c0 + 20, cy), CellState::Free);
+	EXPECT_EQ(grid.logOdds(c0 + 5, cy), 0.0f);  // behind the corrected camera: never traced
+}
+
+/* Depth input before the run's floor frame is known: the keyframe waits; the next keyframe
+ * after the floor brings it in, at the pose the run holds then (moved 3 m sideways, as a
+ * bundle adjustment might), and each keyframe's wall 2.02 m ahead is in the grid. */
+TEST(KeyFrameMap, DepthKeyFramesWaitForTheFloorFrameAndComeBackAsTheyAreNow)
+{
+	CISMOccupancyGrid2D grid = paperGrid();
+	maps::KeyFrameMap& map = grid;
+	map.setFloorFrame(std::nullopt);
+	EXPECT_FALSE(grid.floorKnown());
+
+	const CPose3D arrived = levelCameraAt(0.025), adjusted = levelCameraAt(0.025, 3.025);
+	int lookups = 0;
+	maps::KeyFrameFeed feed;
+	feed.gridInput = maps::GridInput::Depth;
+	feed.keyFrame = [&](uint64_t id) -> std::optional<maps::MapKeyFrame> {
+		lookups++;
+		EXPECT_EQ(id, 1u);
+		return wallKeyFrame(1, adjusted, 2.02f);
+	};
+	map.insertKeyFrame(wallKeyFrame(1, arrived, 2.02f), feed);
+	EXPECT_TRUE(grid.keyframes().empty());
+
+	map.setFloorFrame(CPose3D());  // the floor is z = 0 of the world
+	EXPECT_TRUE(grid.keyframes().empty());
+	map.insertKeyFrame(wallKeyFrame(2, arrived, 2.02f), feed);
+	EXPECT_EQ(lookups, 1);
+	ASSERT_EQ(grid.keyframes().size(), 2u);
+	EXPECT_EQ(grid.keyframes().at(1).T_world_cam, adjusted);
+	// Walls at x = 0.025 + 2.02 = 2.045, in front of each camera: the cells [2.00, 2.05).
+	for (double y : {0.025, 3.025})
+	{
+		EXPECT_EQ(grid.stateAt(2.045, y), CellState::Occupied) << "y = " << y;
+		EXPECT_EQ(grid.stateAt(1.025, y), CellState::Free) << "y = " << y;
+		EXPECT_EQ(grid.stateAt(2.545, y), CellState::Unknown) << "y = " << y;
+	}
+}
+
+TEST(KeyFrameMap, AGridsOwnFloorPoseIsRefusedNamingTheKey)
+{
+	CISMOccupancyGrid2D grid;
+	grid.insertionOptions.T_world_floor = CPose3D(0, 0, -1, 0, 0, 0);
+	maps::KeyFrameMap& map = grid;
+	try
+	{
+		map.setFloorFrame(std::nullopt);
+		FAIL() << "a grid's own T_world_floor must not be replaced silently";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("_insertOpts] T_world_floor"), std::string::npos) << e.what();
+		EXPECT_NE(std::string(e.what()).find("[floor] T_world_floor"), std::string::npos) << e.what();
+	}
+}
+
+/* Every file is tried: with the folder missing, each of the 3D grid's three files fails and
+ * the first failure is thrown naming how many more there were. */
+TEST(KeyFrameMap, OutputsAreTriedOneByOne)
+{
+	keygrid::CSubmappedOccupancyGrid3D grid;
+	const maps::KeyFrameMap& map = grid;
+	const auto dir = std::filesystem::temp_directory_path() / "keygrid_keyframemap_outputs";
+	std::filesystem::remove_all(dir);
+	std::filesystem::create_directories(dir);
+
+	maps::MapOutputFolder good(dir.string(), {});
+	map.writeOutputs(good, "_1");
+	EXPECT_EQ(good.files(), (std::vector<std::string>{"map_3d_1.bt", "map_3d_1.ply", "map_3d_1.bin"}));
+	EXPECT_NO_THROW(good.throwIfAnyFailed());
+	for (const auto& f : good.files()) EXPECT_TRUE(std::filesystem::exists(dir / f)) << f;
+
+	maps::MapOutputFolder missing((dir / "missing").string(), {});
+	map.writeOutputs(missing, "");
+	EXPECT_TRUE(missing.files().empty());
+	try
+	{
+		missing.throwIfAnyFailed();
+		FAIL() << "failures must be reported";
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("(and 2 more map files not written)"), std::string::npos) << e.what();
+	}
+	std::filesystem::remove_all(dir);
+}

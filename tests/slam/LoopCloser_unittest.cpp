@@ -1,0 +1,241 @@
+// LoopCloser on its own, fed keyframes of a synthetic world with known poses (SyntheticFeatures.h):
+// a camera turns on a small circle inside a textured cylinder, looking out at its wall. The
+// keyframe poses carry a growing drift, as odometry would leave them; the measurements are
+// those of the ground-truth poses. On a path past one full turn the loop must be closed between
+// keyframes that see the same wall, its measured relative pose must agree with the ground truth
+// within a bound derived from the noise, and the correction must take the map most of the way
+// to the measurement. On a path that stops short of its start no loop may be claimed.
+#include <keygrid/sfm/Tracker.h>
+#include <keygrid/slam/LoopCloser.h>
+
+#include "SyntheticFeatures.h"
+#include "TestData.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+using namespace keygrid;
+using mrpt::poses::CPose3D;
+
+namespace
+{
+/** The wall: a cylinder about the vertical (camera y, pointing down) axis [m]. */
+constexpr double kWallRadius = 4.0, kWallHalfHeight = 1.5;
+constexpr int kWallPoints = 4000;
+/** The camera's circle [m], heading step between keyframes [deg] and rise per keyframe [m]. */
+constexpr double kPathRadius = 0.5, kHeadingStepDeg = 10.5, kRisePerKeyFrame = 0.005;
+/** Keyframes of a path past one full turn (the last ones see the first ones' wall again), and
+ * of one whose last keyframe heads 87 deg short of the first: from the circle each camera sees
+ * the wall within about 28 deg of its heading, so their views of the wall do not meet. */
+constexpr int kKeyFramesWithLoop = 42, kKeyFramesWithoutLoop = 27;
+/** The farthest a camera on the circle sees the wall: to the wall's far side at the image
+ * corners, bounded by the wall's radius plus the circle's [m]. */
+constexpr double kMaxDepth = kWallRadius + kPathRadius;
+/** A landmark stays in the local map while one of the last kLocalMapKeyFrames keyframes
+ * observes it; a point seen again after that gets a new landmark, as tracking would create one. */
+constexpr sfm::KeyFrameId kLocalMapKeyFrames = 5;
+
+test::SyntheticPoints makeWall(std::mt19937& rng)
+{
+	test::SyntheticPoints w;
+	std::uniform_real_distribution<double> azimuth(0, 2 * M_PI), height(-kWallHalfHeight, kWallHalfHeight);
+	for (int i = 0; i < kWallPoints; i++)
+	{
+		const double a = azimuth(rng);
+		w.p_world.emplace_back(kWallRadius * std::sin(a), height(rng), kWallRadius * std::cos(a));
+	}
+	w.descriptors = test::randomDescriptors(kWallPoints, rng);
+	return w;
+}
+
+double headingDeg(std::size_t k) { return kHeadingStepDeg * static_cast<double>(k); }
+
+/** Ground truth of keyframe k: on the circle, heading k steps about the vertical axis, looking
+ * outwards (optical axis = radial direction), rising a little per keyframe. */
+CPose3D groundTruthPose(std::size_t k)
+{
+	const double heading = headingDeg(k) * M_PI / 180.0;
+	return CPose3D(kPathRadius * std::sin(heading), -kRisePerKeyFrame * static_cast<double>(k), kPathRadius * std::cos(heading), 0, heading, 0);
+}
+
+/** Odometry drift of keyframe k, applied in the world frame: 2 mm and 1 mm along x and z and
+ * 0.046 deg about the vertical per keyframe. */
+CPose3D drift(std::size_t k)
+{
+	const double s = static_cast<double>(k);
+	return CPose3D(0.002 * s, 0, 0.001 * s, 0, 0.0008 * s, 0);
+}
+
+/** The keyframes of one path put through the loop closer, as local mapping would leave them. */
+class LoopRun
+{
+   public:
+	explicit LoopRun(unsigned seed) : m_rng(seed), m_wall(makeWall(m_rng)), m_mapper(m_map, {}, {}), m_loop(m_map, m_mapper, options(), {}) {}
+
+	/** Adds keyframe k (drifted pose, measurements from the ground truth), then loop closing.
+	 * Keyframes are added in path order, so keyframe ids are the path's keyframe numbers. */
+	void addKeyFrame(std::size_t k)
+	{
+		sfm::KeyFrame kf;
+		kf.frameIndex = 10 * k;
+		kf.timestamp = 1.0 + static_cast<double>(k) / 3.0;
+		kf.T_world_cam = drift(k) + groundTruthPose(k);
+		std::vector<int> pointOf;
+		kf.features = test::observePoints(m_wall, groundTruthPose(k), m_cam, m_noise, m_rng, &pointOf);
+		const sfm::KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;
+		associate(id, pointOf);
+		m_pointsOf[id] = std::move(pointOf);
+		std::map<sfm::KeyFrameId, CPose3D> before;
+		for (const auto& [kfId, keyframe] : m_map.keyframes()) before[kfId] = keyframe.T_world_cam;
+		if (auto ev = m_loop.process(id, 10 * k, sfm::intrinsicsOf(m_cam)))
+		{
+			const auto& cur = m_map.keyframe(ev->keyframe);
+			const auto& loop = m_map.keyframe(ev->loopKeyFrame);
+			m_closures.push_back(
+				{*ev, before.at(ev->keyframe) - before.at(ev->loopKeyFrame), cur.T_world_cam - loop.T_world_cam,
+				 before.at(ev->keyframe) - before.at(0), cur.T_world_cam - m_map.keyframe(0).T_world_cam});
+		}
+	}
+
+	/** A closed loop, and the current keyframe's pose relative to the loop keyframe and to the
+	 * first keyframe in the map just before and just after the correction. */
+	struct Closure
+	{
+		slam::LoopClosureEvent event;
+		CPose3D T_loop_cur_before, T_loop_cur_after, T_first_cur_before, T_first_cur_after;
+	};
+
+	const slam::LoopCloser& loopCloser() const { return m_loop; }
+	const std::vector<Closure>& closures() const { return m_closures; }
+	const test::MeasurementNoise& noise() const { return m_noise; }
+
+	/** The wall points both keyframes see, in keyframe a's ground-truth camera frame. */
+	std::vector<Eigen::Vector3d> sharedPoints_cam(sfm::KeyFrameId a, sfm::KeyFrameId b) const
+	{
+		const CPose3D T_world_cam = groundTruthPose(a);
+		const auto& seenByB = m_pointsOf.at(b);
+		std::vector<Eigen::Vector3d> out;
+		for (int j : m_pointsOf.at(a))
+		{
+			if (std::find(seenByB.begin(), seenByB.end(), j) == seenByB.end()) continue;
+			Eigen::Vector3d p;
+			T_world_cam.inverseComposePoint(m_wall.p_world[j].x(), m_wall.p_world[j].y(), m_wall.p_world[j].z(), p.x(), p.y(), p.z());
+			out.push_back(p);
+		}
+		return out;
+	}
+
+   private:
+	static slam::LoopClosingOptions options()
+	{
+		slam::LoopClosingOptions o;
+		o.vocabulary = "train";  // on the first keyframes: no file needed
+		return o;
+	}
+
+	/** Each keypoint observes the landmark of its wall point while that is in the local map,
+	 * else a new landmark at its measured position (as the drifted pose places it). */
+	void associate(sfm::KeyFrameId id, const std::vector<int>& pointOf)
+	{
+		const auto& kf = m_map.keyframe(id);
+		const auto K = sfm::intrinsicsOf(m_cam);
+		std::vector<sfm::LandmarkId> observed;
+		for (std::size_t kp = 0; kp < pointOf.size(); kp++)
+		{
+			auto it = m_landmarkOfPoint.find(pointOf[kp]);
+			if (it != m_landmarkOfPoint.end() && it->second.second + kLocalMapKeyFrames >= id)
+			{
+				m_map.addObservation(it->second.first, id, static_cast<int>(kp));
+				it->second.second = id;
+				observed.push_back(it->second.first);
+				continue;
+			}
+			const Eigen::Vector3d p_cam = sfm::backProject(K, kf.features.undistorted[kp].x, kf.features.undistorted[kp].y, kf.features.depth[kp]);
+			Eigen::Vector3d p_world;
+			kf.T_world_cam.composePoint(p_cam.x(), p_cam.y(), p_cam.z(), p_world.x(), p_world.y(), p_world.z());
+			m_landmarkOfPoint[pointOf[kp]] = {m_map.addLandmark(p_world, id, static_cast<int>(kp)), id};
+		}
+		for (auto l : observed) m_map.updateLandmarkStats(l);
+		m_map.updateCovisibility(id);
+	}
+
+	std::mt19937 m_rng;
+	const core::RgbdCamera m_cam;
+	const test::MeasurementNoise m_noise{0.5, 0.01};
+	test::SyntheticPoints m_wall;
+	sfm::SparseMap m_map;
+	sfm::LocalMapper m_mapper;
+	slam::LoopCloser m_loop;
+	/** wall point -> (its landmark, the last keyframe observing it) */
+	std::map<int, std::pair<sfm::LandmarkId, sfm::KeyFrameId>> m_landmarkOfPoint;
+	std::map<sfm::KeyFrameId, std::vector<int>> m_pointsOf;  //!< the wall points each keyframe sees
+	std::vector<Closure> m_closures;
+};
+
+}  // namespace
+
+TEST(LoopCloser, ClosesTheLoopBetweenKeyFramesOfTheSamePlaceWithTheGroundTruthPose)
+{
+	LoopRun run(1);
+	for (std::size_t k = 0; k < kKeyFramesWithLoop; k++) run.addKeyFrame(k);
+	ASSERT_FALSE(run.closures().empty());
+	const int minInliers = slam::LoopClosingOptions().ransac.minInliers;
+	const double pointSigma = std::sqrt(2.0) * run.noise().pointSigma(kMaxDepth, core::RgbdCamera().fx);
+	for (const auto& c : run.closures())
+	{
+		const auto& ev = c.event;
+		SCOPED_TRACE("loop " + std::to_string(ev.keyframe) + " -> " + std::to_string(ev.loopKeyFrame));
+		// The right pair: the loop keyframe is an old one that sees enough of the current one's
+		// wall to be verified, and at least half as much as the old keyframe that sees most of it.
+		EXPECT_GE(ev.keyframe, ev.loopKeyFrame + static_cast<sfm::KeyFrameId>(slam::LoopClosingOptions().minKeyFrameGap));
+		std::size_t mostShared = 0;
+		for (sfm::KeyFrameId old = 0; old + static_cast<sfm::KeyFrameId>(slam::LoopClosingOptions().minKeyFrameGap) <= ev.keyframe; old++)
+			mostShared = std::max(mostShared, run.sharedPoints_cam(old, ev.keyframe).size());
+		const auto shared = run.sharedPoints_cam(ev.loopKeyFrame, ev.keyframe);
+		EXPECT_GE(shared.size(), static_cast<std::size_t>(minInliers));
+		EXPECT_GE(2 * shared.size(), mostShared);
+
+		// The measurement against the ground truth: a rigid alignment of ev.inliers of the shared
+		// points, each measured in both keyframes; six standard deviations.
+		const CPose3D T_loop_cur_true = groundTruthPose(ev.keyframe) - groundTruthPose(ev.loopKeyFrame);
+		const CPose3D measurementError = ev.T_loop_cur - T_loop_cur_true;
+		const auto sigma = test::alignmentSigmas(shared, pointSigma, ev.inliers);
+		EXPECT_GE(ev.inliers, minInliers);
+		EXPECT_LT(measurementError.translation().norm(), 6 * sigma.metres) << ev.T_loop_cur << " vs " << T_loop_cur_true;
+		EXPECT_LT(test::rotationAngleDeg(measurementError), 6 * sigma.degrees) << ev.T_loop_cur << " vs " << T_loop_cur_true;
+
+		// The correction: the drift made the map disagree with the measurement by centimetres
+		// and more than a degree. The pose graph (unit weights) shares that out between the
+		// loop edge and the chain of odometry and covisibility edges joining the two keyframes;
+		// one edge against many, the loop edge keeps less than half of it.
+		const CPose3D before = c.T_loop_cur_before - ev.T_loop_cur, after = c.T_loop_cur_after - ev.T_loop_cur;
+		EXPECT_GT(before.translation().norm(), 0.03);
+		EXPECT_GT(test::rotationAngleDeg(before), 1.0);
+		EXPECT_LT(after.translation().norm(), 0.5 * before.translation().norm()) << "before " << before << ", after " << after;
+		EXPECT_LT(test::rotationAngleDeg(after), 0.5 * test::rotationAngleDeg(before)) << "before " << before << ", after " << after;
+		// ... and brought the current keyframe closer to its true pose relative to the first.
+		const CPose3D truth = groundTruthPose(ev.keyframe) - groundTruthPose(0);
+		const CPose3D errorBefore = c.T_first_cur_before - truth, errorAfter = c.T_first_cur_after - truth;
+		EXPECT_LT(errorAfter.translation().norm(), errorBefore.translation().norm()) << "before " << errorBefore << ", after " << errorAfter;
+		EXPECT_LT(test::rotationAngleDeg(errorAfter), test::rotationAngleDeg(errorBefore)) << "before " << errorBefore << ", after " << errorAfter;
+	}
+	EXPECT_TRUE(run.loopCloser().lastPoseGraph().has_value());
+}
+
+TEST(LoopCloser, ClaimsNoLoopOnAPathWithoutRevisit)
+{
+	LoopRun run(2);
+	for (std::size_t k = 0; k < kKeyFramesWithoutLoop; k++) run.addKeyFrame(k);
+	EXPECT_TRUE(run.closures().empty());
+	// Detection ran on every keyframe after the vocabulary was trained, and closed nothing.
+	int queried = 0;
+	for (const auto& q : run.loopCloser().queries())
+	{
+		EXPECT_NE(q.outcome, slam::LoopQueryOutcome::Closed) << "keyframe " << q.keyframe;
+		queried += q.outcome != slam::LoopQueryOutcome::NoVocabulary;
+	}
+	// The keyframe that completes the training set trains the vocabulary and is not queried.
+	EXPECT_EQ(queried, kKeyFramesWithoutLoop - slam::LoopClosingOptions().trainKeyFrames);
+	EXPECT_FALSE(run.loopCloser().lastPoseGraph().has_value());
+}
