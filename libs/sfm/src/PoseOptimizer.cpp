@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <memory>
 #include <stdexcept>
 
 namespace keygrid::sfm
@@ -17,20 +16,36 @@ constexpr double kBehindCamera = 1e30;
 
 bool usesDepth(const PoseObservation& ob, const PoseOptimizerOptions& o) { return ob.depth > 0 && ob.depth < o.maxDepthForRgbd; }
 
-/** Squared residual of one observation at (q, t) = T_cam_world (no robust loss). */
-double chi2At(const double q[4], const double t[3], const PoseObservation& ob, const PinholeIntrinsics& K, const PoseOptimizerOptions& o)
+/** One observation as a residual term of the pose solver (no robust loss). */
+PoseResidualTerm residualTerm(const PoseObservation& ob, const PoseOptimizerOptions& o)
 {
-	double u, v, ur;
-	const double p[3] = {ob.p_world.x(), ob.p_world.y(), ob.p_world.z()};
-	if (!projectRgbd(q, t, p, K, o.bf, u, v, ur)) return kBehindCamera;
-	const double du = (ob.uv.x() - u) * ob.invSigma, dv = (ob.uv.y() - v) * ob.invSigma;
-	double e = du * du + dv * dv;
+	PoseResidualTerm term;
+	term.p_world = ob.p_world;
+	term.uv = ob.uv;
+	term.invSigma = ob.invSigma;
 	if (usesDepth(ob, o))
 	{
-		const double dr = (o.bf / ob.depth - (u - ur)) / o.disparitySigma;  // u - ur = bf / z
-		e += dr * dr;
+		term.disparity = o.bf / ob.depth;
+		term.invSigmaDisparity = 1.0 / o.disparitySigma;
 	}
-	return e;
+	return term;
+}
+
+/** (R, t) = T_cam_world of the camera pose T_world_cam. */
+void cameraFromWorld(const mrpt::poses::CPose3D& T_world_cam, Eigen::Matrix3d& R, Eigen::Vector3d& t)
+{
+	double q[4], tq[3];
+	toCeres(T_world_cam, q, tq);
+	R = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
+	t = Eigen::Vector3d(tq[0], tq[1], tq[2]);
+}
+
+/** Squared residual of a term at (R, t) = T_cam_world (no robust loss); kBehindCamera when the
+ * point is not in front of the camera. */
+double chi2At(const Eigen::Matrix3d& R, const Eigen::Vector3d& t, const PoseResidualTerm& term, const PinholeIntrinsics& K, const PoseOptimizerOptions& o)
+{
+	double e;
+	return poseResidualSquaredNorm(R, t, term, K, o.bf, e) ? e : kBehindCamera;
 }
 }  // namespace
 
@@ -38,9 +53,10 @@ double inlierThreshold(const PoseObservation& ob, const PoseOptimizerOptions& o)
 
 double observationChi2(const mrpt::poses::CPose3D& T_world_cam, const PoseObservation& ob, const PinholeIntrinsics& K, const PoseOptimizerOptions& o)
 {
-	double q[4], t[3];
-	toCeres(T_world_cam, q, t);
-	const double e = chi2At(q, t, ob, K, o);
+	Eigen::Matrix3d R;
+	Eigen::Vector3d t;
+	cameraFromWorld(T_world_cam, R, t);
+	const double e = chi2At(R, t, residualTerm(ob, o), K, o);
 	return e >= kBehindCamera ? std::numeric_limits<double>::infinity() : e;
 }
 
@@ -55,12 +71,13 @@ PoseOptimizerResult optimizePoseAnchored(
 		if (isAnchor[i]) anchors.push_back(obs[i]);
 	if (static_cast<int>(anchors.size()) < std::max(minAnchors, 3)) return optimizePose(T_world_cam, obs, K, o);
 	optimizePose(T_world_cam, anchors, K, o);
-	double q[4], t[3];
-	toCeres(T_world_cam, q, t);
+	Eigen::Matrix3d R;
+	Eigen::Vector3d t;
+	cameraFromWorld(T_world_cam, R, t);
 	std::vector<PoseObservation> kept;
 	std::vector<std::size_t> keptIndex;
 	for (std::size_t i = 0; i < obs.size(); i++)
-		if (isAnchor[i] || chi2At(q, t, obs[i], K, o) <= chi2Factor * inlierThreshold(obs[i], o))
+		if (isAnchor[i] || chi2At(R, t, residualTerm(obs[i], o), K, o) <= chi2Factor * inlierThreshold(obs[i], o))
 		{
 			kept.push_back(obs[i]);
 			keptIndex.push_back(i);
@@ -114,32 +131,15 @@ PoseOptimizerResult optimizePose(
 {
 	if (obs.empty()) throw std::invalid_argument("optimizePose: no observations");
 	if (!(o.disparitySigma > 0)) throw std::invalid_argument("optimizePose: disparitySigma must be > 0");
-	double q[4], tq[3];
-	toCeres(T_world_cam, q, tq);
-	Eigen::Matrix3d R = Eigen::Quaterniond(q[3], q[0], q[1], q[2]).normalized().toRotationMatrix();
-	Eigen::Vector3d t(tq[0], tq[1], tq[2]);
+	Eigen::Matrix3d R;
+	Eigen::Vector3d t;
+	cameraFromWorld(T_world_cam, R, t);
 	const std::size_t n = obs.size();
 
-	// Each observation as a residual term (AnalyticReprojectionCost's model); the Huber
-	// threshold is set per round.
+	// Each observation as a residual term; the Huber threshold is set per round.
 	std::vector<PoseResidualTerm> all(n);
-	for (std::size_t i = 0; i < n; i++)
-	{
-		auto& term = all[i];
-		term.p_world = obs[i].p_world;
-		term.uv = obs[i].uv;
-		term.invSigma = obs[i].invSigma;
-		if (usesDepth(obs[i], o))
-		{
-			term.disparity = o.bf / obs[i].depth;
-			term.invSigmaDisparity = 1.0 / o.disparitySigma;
-		}
-	}
-	const auto chi2 = [&](std::size_t i)
-	{
-		double e;
-		return poseResidualSquaredNorm(R, t, all[i], K, o.bf, e) ? e : kBehindCamera;
-	};
+	for (std::size_t i = 0; i < n; i++) all[i] = residualTerm(obs[i], o);
+	const auto chi2 = [&](std::size_t i) { return chi2At(R, t, all[i], K, o); };
 
 	PoseOptimizerResult res;
 	res.inlier.assign(n, 1);
