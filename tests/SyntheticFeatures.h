@@ -34,6 +34,21 @@ inline cv::Mat randomDescriptors(int n, std::mt19937& rng)
 	return d;
 }
 
+/** `n` points on the inside of a vertical cylinder about the world's y axis (radius [m],
+ * heights in [-halfHeight, halfHeight]), at random azimuths: a textured wall all around. */
+inline SyntheticPoints cylinderWall(std::mt19937& rng, double radius, double halfHeight, int n)
+{
+	SyntheticPoints w;
+	std::uniform_real_distribution<double> azimuth(0, 2 * M_PI), height(-halfHeight, halfHeight);
+	for (int i = 0; i < n; i++)
+	{
+		const double a = azimuth(rng);
+		w.p_world.emplace_back(radius * std::sin(a), height(rng), radius * std::cos(a));
+	}
+	w.descriptors = randomDescriptors(n, rng);
+	return w;
+}
+
 /** Gaussian noise of the synthetic measurements (0: exact). */
 struct MeasurementNoise
 {

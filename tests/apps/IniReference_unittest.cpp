@@ -81,6 +81,18 @@ TEST(IniReference, ListsEverySlamConfigKeyWithItsDefault)
 	EXPECT_EQ(comment, "detect and correct loops");
 }
 
+// Every key of keygrid-slam's sections and of the plugins whose options are OptionFields tables
+// has a description.
+TEST(IniReference, EveryKeyIsDescribed)
+{
+	std::vector<IniSection> sections = slamConfigReference();
+	const auto hoc = mapPluginReference("hocPointsMap");
+	ASSERT_TRUE(hoc.has_value());
+	sections.insert(sections.end(), hoc->begin(), hoc->end());
+	for (const auto& s : sections)
+		for (const auto& k : s.keys) EXPECT_FALSE(k.description.empty()) << "[" << s.name << "] " << k.key;
+}
+
 // Loading a map definition from the reference's keys and values gives exactly the compiled-in
 // defaults (same dump as a default definition), and a changed value does change it: the
 // reference names the right sections and keys, and its (shortened) numbers are exact.
@@ -116,7 +128,10 @@ TEST(IniReference, MapPluginSectionsReproduceTheDefaults)
 		for (const auto& k : ref->front().keys)
 			if (k.defaultValue.find_first_not_of("0123456789.-") == std::string::npos && k.key != "enableSaveAs3DObject")
 			{
-				ini.write(ref->front().name, k.key, std::to_string(std::stod(k.defaultValue) * 2 + 1));
+				// Integers are read strictly: a whole default gets a whole value.
+				const double changed = std::stod(k.defaultValue) * 2 + 1;
+				const bool whole = k.defaultValue.find('.') == std::string::npos;
+				ini.write(ref->front().name, k.key, whole ? std::to_string(static_cast<long long>(changed)) : std::to_string(changed));
 				EXPECT_NE(dump(ini), withoutNegativeZeros(d0.str())) << name << " " << k.key;
 				break;
 			}

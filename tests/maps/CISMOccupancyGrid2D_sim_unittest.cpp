@@ -92,8 +92,8 @@ const SimRoomRun& simSurveyRun()
 }
 }  // namespace
 
-// The bounds, on the walk that sees the room (measured here with 60 keyframes: see
-// the printed line; 180 keyframes in the benchmark: F1 0.910, free accuracy 0.998).
+// The bounds, on the walk that sees the room (60 keyframes here; the benchmark's
+// figures with 180: doc/evaluation.md, "2D grid").
 TEST(CISMOccupancyGrid2DSim, SurveyDenseDepthMeetsTheFloorPlanBounds)
 {
 	const auto& m = simSurveyRun().dense;
@@ -116,8 +116,8 @@ TEST(CISMOccupancyGrid2DSim, SurveySparseKeypointsMatchTheVisiblePlan)
 
 // room_loop: ~22 % of the plan's occupied cells are never visible from the circle in the middle
 // (the backs of the shelf, cabinet, pillar and crate, the walls behind them), which caps the
-// recall against the full plan; against the visible part the dense grid reaches F1 0.99. The
-// bounds on the full plan are regression bounds below the measured values.
+// recall against the full plan. The bounds on the full plan are empirical regression margins
+// (the figures: doc/evaluation.md, "2D grid").
 TEST(CISMOccupancyGrid2DSim, DenseDepthAtGroundTruthPosesMatchesFloorPlan)
 {
 	const auto& m = simRoomRun().dense;

@@ -77,7 +77,8 @@ TEST(ISMFloorPlane, FindsAFloorHoldingAFewPerCentOfThePoints)
 	const auto plane = estimateFloorPlane(pts, TVector3D(0, 0, 1), cam, o);
 	ASSERT_TRUE(plane.has_value());
 	EXPECT_GT(plane->normal.z, std::cos(1.0 * M_PI / 180.0));
-	// The refined plane also takes in the walls' lowest 2 cm (measured: 1.4 cm low, 764 inliers).
+	// The refined plane also takes in the walls' lowest 2 cm, so it may sit up to 2 cm low; the
+	// inlier range is an empirical margin.
 	EXPECT_NEAR(plane->height(cam), 1.3, 0.02);
 	EXPECT_GE(plane->inliers, 550u);
 	EXPECT_LE(plane->inliers, 900u);

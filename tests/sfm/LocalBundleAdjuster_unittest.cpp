@@ -386,6 +386,46 @@ TEST(LocalBundleAdjuster, OptionsRoundTripAndRejectUnknownSolver)
 	}
 	catch (const std::invalid_argument& e)
 	{
-		EXPECT_NE(std::string(e.what()).find("linear_solver = cholmod"), std::string::npos) << e.what();
+		EXPECT_NE(std::string(e.what()).find("[mapping] linear_solver = 'cholmod'"), std::string::npos) << e.what();
 	}
+}
+
+TEST(LocalMapper, PhasesGiveTheResultOfProcessAndDropASolveAcrossACorrection)
+{
+	// Threaded mode's phases (prepare, solve apart from the map, complete) against process() on
+	// the same map: the same map afterwards; a loop correction during the solve drops its result.
+	Scene inOneGo, inPhases, corrected;
+	for (Scene* s : {&inOneGo, &inPhases, &corrected}) buildScene(*s, 0.01, 0.02);
+	LocalMapperOptions o;
+	o.ba.iterations = 30;
+	LocalMapper oneGo(inOneGo.map, o, {}), phases(inPhases.map, o, {}), dropping(corrected.map, o, {});
+	const auto repOneGo = oneGo.process(3, K);
+	auto pass = phases.prepare(3, K);
+	pass.solve();
+	const auto repPhases = phases.complete(std::move(pass));
+	EXPECT_FALSE(repPhases.baDiscarded);
+	EXPECT_GT(repPhases.ba.observations, 0);
+	EXPECT_EQ(repPhases.ba.observations, repOneGo.ba.observations);
+	EXPECT_EQ(repPhases.ba.finalCost, repOneGo.ba.finalCost);
+	EXPECT_EQ(repPhases.culledKeyFrames, repOneGo.culledKeyFrames);
+	ASSERT_EQ(inPhases.map.numKeyFrames(), inOneGo.map.numKeyFrames());
+	for (const auto& [id, kf] : inOneGo.map.keyframes()) EXPECT_TRUE(inPhases.map.keyframe(id).T_world_cam == kf.T_world_cam) << "kf " << id;
+	ASSERT_EQ(inPhases.map.numLandmarks(), inOneGo.map.numLandmarks());
+	for (const auto& [id, lm] : inOneGo.map.landmarks()) EXPECT_EQ(inPhases.map.landmark(id).p_world, lm.p_world) << "landmark " << id;
+	const auto stages = [](const LocalMappingReport& r) {
+		std::vector<std::string> names;
+		for (const auto& [name, seconds] : r.stageSeconds) names.push_back(name);
+		return names;
+	};
+	EXPECT_EQ(stages(repOneGo), (std::vector<std::string>{"cull", "triangulate", "fuse", "ba", "cull_keyframes"}));
+	EXPECT_EQ(stages(repPhases), (std::vector<std::string>{"cull", "triangulate", "fuse", "ba_build", "ba_solve", "ba_apply", "cull_keyframes"}));
+
+	const CPose3D before = corrected.map.keyframe(3).T_world_cam;
+	auto dropped = dropping.prepare(3, K);
+	corrected.map.noteCorrection();  // a loop closed while the solve ran
+	dropped.solve();
+	const auto repDropped = dropping.complete(std::move(dropped));
+	EXPECT_TRUE(repDropped.baDiscarded);
+	EXPECT_EQ(repDropped.ba.observations, 0);
+	EXPECT_TRUE(corrected.map.keyframe(3).T_world_cam == before);
 }

@@ -3,8 +3,8 @@
  * "outcome", report.json "mode") and reads back ([slam] mode, --mode): scripts and old
  * outputs depend on them, so they are pinned here.
  */
+#include <keygrid/loop/LoopCloser.h>
 #include <keygrid/sfm/Tracker.h>
-#include <keygrid/slam/LoopCloser.h>
 #include <keygrid/slam/SlamConfig.h>
 #include <mrpt/config/CConfigFileMemory.h>
 
@@ -27,18 +27,18 @@ TEST(EnumNames, TrackingMethodsAreTheWordsOfFramesCsv)
 
 TEST(EnumNames, LoopQueryOutcomesAreTheWordsOfLoopQueriesCsv)
 {
-	using slam::LoopQueryOutcome;
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::Closed), "closed");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::NoVocabulary), "no_vocabulary");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::AfterLoop), "after_loop");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::NoCandidate), "no_candidate");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::NotConsistent), "not_consistent");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::FewMatches), "few_matches");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::RansacFailed), "ransac_failed");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::Implausible), "implausible");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::MergePending), "merge_pending");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::MergeSeenThrough), "merge_seen_through");
-	EXPECT_STREQ(slam::toString(LoopQueryOutcome::PoseGraphFailed), "pose_graph_failed");
+	using loop::LoopQueryOutcome;
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::Closed), "closed");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::NoVocabulary), "no_vocabulary");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::AfterLoop), "after_loop");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::NoCandidate), "no_candidate");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::NotConsistent), "not_consistent");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::FewMatches), "few_matches");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::RansacFailed), "ransac_failed");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::Implausible), "implausible");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::MergePending), "merge_pending");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::MergeSeenThrough), "merge_seen_through");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::PoseGraphFailed), "pose_graph_failed");
 }
 
 TEST(EnumNames, RunModeIsReadAndWrittenAsSequentialOrThreaded)

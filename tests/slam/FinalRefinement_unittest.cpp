@@ -11,7 +11,7 @@ TEST(FinalRefinement, SeedsAreBothEndsOfEveryLoopNewestFirstThenTheNewestKeyFram
 {
 	sfm::SparseMap map;
 	for (int i = 0; i < 5; i++) map.addKeyFrame(sfm::KeyFrame{});
-	std::vector<slam::LoopClosureEvent> loops(2);
+	std::vector<loop::LoopClosureEvent> loops(2);
 	loops[0].keyframe = 3;
 	loops[0].loopKeyFrame = 0;
 	loops[1].keyframe = 4;

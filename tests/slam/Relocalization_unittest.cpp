@@ -68,11 +68,13 @@ TEST(Relocalization, KidnappedCameraIsRelocalizedOnOldKeyframesThroughTheVocabul
 	ASSERT_FALSE(events.empty()) << js;
 	EXPECT_LE(events[0]["frame"].get<std::size_t>(), kidnap + 2);
 	EXPECT_TRUE(events[0]["place_recognition"].get<bool>());
-	// Measured 2026-11-21: one lost frame (the jump), then tracked.
+	// Empirical margin: the jump's frame and two more may be lost (frames lost after the jump:
+	// doc/evaluation.md, "Relocalization").
 	EXPECT_GE(r.tracked, order.size() - 3);
 
 	// Align on the frames before the jump, then every frame from 3 after it must be at its
-	// true pose (measured: 3 mm).
+	// true pose: 2 cm, an empirical margin over the error after the jump in doc/evaluation.md,
+	// "Relocalization".
 	const auto est = core::readTumTrajectory(o.output + "/trajectory.txt");
 	const auto& ref = kidnappedGt;
 	ASSERT_EQ(est.size(), order.size());

@@ -80,7 +80,7 @@ TEST(KeyFrameImageCodec, OptionsValidateAndLoad)
 	}
 	catch (const std::invalid_argument& e)
 	{
-		EXPECT_NE(std::string(e.what()).find("png_compression must be in 0..9, got 12"), std::string::npos) << e.what();
+		EXPECT_NE(std::string(e.what()).find("[store] png_compression = 12 (must be in [0, 9])"), std::string::npos) << e.what();
 	}
 	ImageCodecOptions p;
 	p.colourFormat = "jpg";

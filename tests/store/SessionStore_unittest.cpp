@@ -371,7 +371,7 @@ TEST(SessionStore, DamagedFileIsRefused)
 TEST(SessionStoreOptions, IniRoundTripAndErrorsNameTheKey)
 {
 	SessionStoreOptions o;
-	EXPECT_TRUE(o.isValid());
+	EXPECT_NO_THROW(o.validate());
 	o.durability = "normal";
 	o.cacheSizeKiB = 4096;
 	o.busyTimeoutMs = 100;

@@ -47,45 +47,46 @@ mrpt::maps::CMetricMap* CHOCPointsMap::internal_CreateFromMapDefinition(const mr
 }
 
 // ---------------------------------------------------------------- options
-namespace
+core::OptionFields CHOCPointsMap::TInsertionOptions::fields()
 {
-int readDecimation(const mrpt::config::CConfigFileBase& c, const std::string& s, int current)
-{
-	const double dec = detail::readNumber(c, s, "decimation", current);
-	detail::require(dec >= 1 && dec == std::floor(dec), "[" + s + "] decimation", dec, "an integer >= 1");
-	return static_cast<int>(dec);
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("decimation", decimation, "use every n-th depth pixel (rows and columns)", R::atLeast(1));
+	f.add("point_spacing", pointSpacing, "[m] new points only in voxels of this size without points", R::positive());
+	f.add("prune", prune, "remove points below prune_threshold after each insertion");
+	return f;
 }
-}  // namespace
 
 void CHOCPointsMap::TInsertionOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	decimation = readDecimation(c, s, decimation);
-	pointSpacing = detail::readNumber(c, s, "point_spacing", pointSpacing);
-	detail::require(pointSpacing > 0, "[" + s + "] point_spacing", pointSpacing, "> 0 m");
-	prune = detail::readBool(c, s, "prune", prune);
+	fields().read(c, s);
+	core::validateFields(*this, s);
 }
 
 void CHOCPointsMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	c.write(s, "decimation", decimation, 30, 40, "use every n-th depth pixel (rows and columns)");
-	c.write(s, "point_spacing", pointSpacing, 30, 40, "[m] new points only in voxels of this size without points");
-	c.write(s, "prune", prune ? "true" : "false", 30, 40, "remove points below prune_threshold after each insertion");
+	core::writeFields(*this, c, s);
+}
+
+core::OptionFields CHOCPointsMap::TLikelihoodOptions::fields()
+{
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("decimation", decimation, "use every n-th depth pixel", R::atLeast(1));
+	f.add("sigma", sigma, "[m] std. dev. of the point distance", R::positive());
+	f.add("outlier_probability", outlierProbability, "floor of one pixel's likelihood", R::between(0, 1));
+	return f;
 }
 
 void CHOCPointsMap::TLikelihoodOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	decimation = readDecimation(c, s, decimation);
-	sigma = detail::readNumber(c, s, "sigma", sigma);
-	detail::require(sigma > 0, "[" + s + "] sigma", sigma, "> 0 m");
-	outlierProbability = detail::readNumber(c, s, "outlier_probability", outlierProbability);
-	detail::require(outlierProbability > 0 && outlierProbability < 1, "[" + s + "] outlier_probability", outlierProbability, "in (0, 1)");
+	fields().read(c, s);
+	core::validateFields(*this, s);
 }
 
 void CHOCPointsMap::TLikelihoodOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	c.write(s, "decimation", decimation, 30, 40, "use every n-th depth pixel");
-	c.write(s, "sigma", sigma, 30, 40, "[m] std. dev. of the point distance");
-	c.write(s, "outlier_probability", outlierProbability, 30, 40, "floor of one pixel's likelihood");
+	core::writeFields(*this, c, s);
 }
 
 // ---------------------------------------------------------------- points
@@ -195,14 +196,15 @@ bool CHOCPointsMap::internal_insertObservation(const mrpt::obs::CObservation& ob
 	// 2. New points where no point exists yet.
 	auto idx = indexPoints(m_points, insertionOptions.pointSpacing);
 	const int step = insertionOptions.decimation;
+	const core::PinholeIntrinsics K = cam.pinhole();
 	for (int r = step / 2; r < depth.rows; r += step)
 		for (int c = step / 2; c < depth.cols; c += step)
 		{
 			const float d = depth.at<float>(r, c);
 			if (!(d > 0) || !std::isfinite(d) || d < o.visibleDepthMin || d > o.visibleDepthMax) continue;
-			const double xc = (c - cam.cx) / cam.fx * d, yc = (r - cam.cy) / cam.fy * d;
+			const Eigen::Vector3d p_cam = K.backProject(c, r, d);
 			Point pt;
-			T_world_cam.composePoint(xc, yc, d, pt.p.x, pt.p.y, pt.p.z);
+			T_world_cam.composePoint(p_cam.x(), p_cam.y(), p_cam.z(), pt.p.x, pt.p.y, pt.p.z);
 			const VoxelKey k = voxelOf(pt.p, insertionOptions.pointSpacing);
 			if (idx.count(k)) continue;
 			pt.id = m_nextId++;
@@ -232,13 +234,15 @@ double CHOCPointsMap::internal_computeObservationLikelihood(const mrpt::obs::COb
 	const double inv2s2 = 1.0 / (2 * likelihoodOptions.sigma * likelihoodOptions.sigma);
 	double logLik = 0;
 	const int step = likelihoodOptions.decimation;
+	const core::PinholeIntrinsics K = cam.pinhole();
 	for (int r = step / 2; r < depth.rows; r += step)
 		for (int c = step / 2; c < depth.cols; c += step)
 		{
 			const float d = depth.at<float>(r, c);
 			if (!(d > 0) || !std::isfinite(d)) continue;
+			const Eigen::Vector3d p_cam = K.backProject(c, r, d);
 			mrpt::math::TPoint3D p;
-			T_world_cam.composePoint((c - cam.cx) / cam.fx * d, (r - cam.cy) / cam.fy * d, d, p.x, p.y, p.z);
+			T_world_cam.composePoint(p_cam.x(), p_cam.y(), p_cam.z(), p.x, p.y, p.z);
 			const VoxelKey k = voxelOf(p, s);
 			double best = 1e300;
 			for (int dx = -1; dx <= 1; dx++)

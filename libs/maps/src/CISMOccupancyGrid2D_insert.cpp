@@ -3,6 +3,7 @@
  * rebuild after loop closure, and the observation likelihood.
  */
 #include <keygrid/core/FrameConventions.h>
+#include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/GridRayTraversal.h>
 
@@ -19,6 +20,12 @@ using mrpt::poses::CPose3D;
 
 namespace
 {
+/** The scan camera's pinhole model in float, like the points the inner loops make. */
+core::BasicPinholeIntrinsics<float> floatPinhole(const mrpt::obs::CObservation3DRangeScan& obs)
+{
+	return core::RgbdCamera::FromTCamera(obs.cameraParams, obs.rangeUnits).pinhole().cast<float>();
+}
+
 /** Rotation + translation of T_floor_cam as plain floats for the inner loops. */
 struct RigidF
 {
@@ -58,19 +65,17 @@ std::vector<TPoint3Df> keygrid::depthToCameraPoints(
 	if (!obs.hasRangeImage) return out;
 	const int rows = static_cast<int>(obs.rangeImage.rows());
 	const int cols = static_cast<int>(obs.rangeImage.cols());
-	const auto& K = obs.cameraParams;
-	const float fx = static_cast<float>(K.fx()), fy = static_cast<float>(K.fy());
-	const float cx = static_cast<float>(K.cx()), cy = static_cast<float>(K.cy());
+	const auto K = floatPinhole(obs);
 	const float units = obs.rangeUnits;
 	out.reserve(static_cast<size_t>(rows / decimation + 1) * static_cast<size_t>(cols / decimation + 1));
 	for (int r = 0; r < rows; r += decimation)
 	{
-		const float yn = (static_cast<float>(r) - cy) / fy;
+		const float yn = K.rayY(static_cast<float>(r));
 		for (int c = 0; c < cols; c += decimation)
 		{
 			const uint16_t raw = obs.rangeImage(r, c);
 			if (raw == 0) continue;
-			const float xn = (static_cast<float>(c) - cx) / fx;
+			const float xn = K.rayX(static_cast<float>(c));
 			float z = raw * units;
 			if (!obs.range_is_depth) z /= std::sqrt(1.0f + xn * xn + yn * yn);
 			out.emplace_back(xn * z, yn * z, z);
@@ -347,19 +352,17 @@ std::vector<TPoint3Df> CISMOccupancyGrid2D::reduceDepth(
 
 	const int rows = static_cast<int>(obs.rangeImage.rows());
 	const int cols = static_cast<int>(obs.rangeImage.cols());
-	const auto& K = obs.cameraParams;
-	const float fx = static_cast<float>(K.fx()), fy = static_cast<float>(K.fy());
-	const float cx = static_cast<float>(K.cx()), cy = static_cast<float>(K.cy());
+	const auto K = floatPinhole(obs);
 	const float units = obs.rangeUnits;
 	const float hMin = static_cast<float>(o.obstacleMinHeight), hMax = static_cast<float>(o.obstacleMaxHeight);
 	const float fTol = static_cast<float>(o.floorTolerance);
 	const float maxR2 = static_cast<float>(o.maxRange * o.maxRange);
 	std::vector<float> xn(static_cast<size_t>(cols));
-	for (int c = 0; c < cols; c++) xn[static_cast<size_t>(c)] = (static_cast<float>(c) - cx) / fx;
+	for (int c = 0; c < cols; c++) xn[static_cast<size_t>(c)] = K.rayX(static_cast<float>(c));
 	const int dec = o.depthDecimation;
 	for (int r = 0; r < rows; r += dec)
 	{
-		const float yn = (static_cast<float>(r) - cy) / fy;
+		const float yn = K.rayY(static_cast<float>(r));
 		for (int c = 0; c < cols; c += dec)
 		{
 			const uint16_t raw = obs.rangeImage(r, c);

@@ -113,13 +113,15 @@ double CSubmappedOccupancyGrid3D::internal_computeObservationLikelihood(
 		core::cameraPoseFromSensorPose(takenFrom + scan->sensorPose);
 	const unsigned dec = likelihoodOptions.decimation;
 	const double pMin = likelihoodOptions.minProbability;
+	const core::PinholeIntrinsics K = cam.pinhole();
 	double logLik = 0;
 	for (int r = 0; r < depth.rows; r += static_cast<int>(dec))
 		for (int c = 0; c < depth.cols; c += static_cast<int>(dec))
 		{
 			const float z = depth.at<float>(r, c);
 			if (!(z > 0)) continue;
-			const mrpt::math::TPoint3D pc((c - cam.cx) / cam.fx * z, (r - cam.cy) / cam.fy * z, z);
+			const Eigen::Vector3d p_cam = K.backProject(c, r, z);
+			const mrpt::math::TPoint3D pc(p_cam.x(), p_cam.y(), p_cam.z());
 			if (pc.norm() > likelihoodOptions.maxRange) continue;
 			const auto L = logOddsAt(T_world_cam.composePoint(pc));
 			const double p = L ? 1.0 / (1.0 + std::exp(-double(*L))) : 0.5;

@@ -82,12 +82,13 @@ void PixelRayTable::update(const core::RgbdCamera& cam)
 	m_xy.assign(2 * static_cast<std::size_t>(m_w) * m_h, 0.0f);
 	if (!cam.hasDistortion())
 	{
+		const core::PinholeIntrinsics K = cam.pinhole();
 		for (unsigned v = 0; v < m_h; ++v)
 			for (unsigned u = 0; u < m_w; ++u)
 			{
 				float* p = &m_xy[2 * (static_cast<std::size_t>(v) * m_w + u)];
-				p[0] = static_cast<float>((u - cam.cx) / cam.fx);
-				p[1] = static_cast<float>((v - cam.cy) / cam.fy);
+				p[0] = static_cast<float>(K.rayX(u));
+				p[1] = static_cast<float>(K.rayY(v));
 			}
 	}
 	else

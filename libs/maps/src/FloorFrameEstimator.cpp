@@ -1,6 +1,7 @@
 /** \file FloorFrameEstimator.cpp
  * The run's floor frame: options, the lowest-plane search and the pooled estimator.
  */
+#include <keygrid/core/PinholeIntrinsics.h>
 #include <keygrid/maps/FloorFrameEstimator.h>
 #include <mrpt/math/CQuaternion.h>
 #include <mrpt/math/geometry.h>
@@ -20,81 +21,65 @@ using mrpt::math::TPoint3Df;
 using mrpt::math::TVector3D;
 
 // ------------------------------------------------------------------ options
+core::OptionFields FloorFrameOptions::fields()
+{
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.addCustom(
+		"T_world_floor",
+		{[this](const std::string& text) { givenPose = text == "estimate" ? "" : text; },
+		 [this] { return givenPose.empty() ? std::string("estimate") : givenPose; }},
+		"estimate, or the floor frame given as [x y z yaw pitch roll] (m, deg) in the SLAM world");
+	f.addCustom(
+		"up_hint",
+		{[this](const std::string& text) {
+			 std::istringstream is(text);
+			 double x = 0, y = 0, z = 0;
+			 if (!(is >> x >> y >> z) || !(is >> std::ws).eof()) throw std::invalid_argument("expected three numbers \"x y z\"");
+			 upHint = TVector3D(x, y, z);
+		 },
+		 [this] {
+			 char up[96];
+			 std::snprintf(up, sizeof(up), "%g %g %g", upHint.x, upHint.y, upHint.z);
+			 return std::string(up);
+		 }},
+		"\"up\" in the SLAM world for the first search; 0 0 0 = mean -y of the keyframe cameras");
+	f.add("initial_keyframes", initialKeyframes, "estimate at every keyframe until this many contributed (and the floor is found)", R::atLeast(1));
+	f.add("reestimate_every", reestimateEvery, "then re-estimate every N keyframes and after trajectory corrections", R::atLeast(1));
+	f.add("reservoir_size", reservoirSize, "depth samples kept (uniform over all keyframes)", R::atLeast(100));
+	f.add("pixel_step", pixelStep, "depth samples: every n-th pixel in rows and columns", R::atLeast(1));
+	f.add("min_depth", minDepth, "depth range of the samples, lower end [m]", R::atLeast(0));
+	f.add("max_depth", maxDepth, "depth range of the samples, upper end [m] (above min_depth)");
+	f.add("min_change", minChange, "smaller moves of the floor [m] ...", R::atLeast(0));
+	f.add("min_change_deg", minChangeDeg, "... and tilts [deg] keep the previous estimate", R::atLeast(0));
+	f.add("inlier_distance", inlierDistance, "point-to-plane distance of a floor inlier [m]", R::positive());
+	f.add("hypotheses", hypotheses, "RANSAC hypotheses per round", R::atLeast(1));
+	f.add("rounds", rounds, "search rounds; up = the previous round's normal", R::atLeast(1));
+	f.add("max_tilt_deg", maxTiltDeg, "largest angle normal / up hint in the first round [deg]", R::between(0, 90));
+	f.add("refine_tilt_deg", refineTiltDeg, "the same in later rounds [deg]", R::between(0, 90));
+	f.add("lowest_fraction", lowestFraction, "hypotheses from this share of the lowest samples", R::aboveUpTo(0, 1));
+	f.add("min_support", minSupport, "least floor support: share of the samples ...", R::aboveUpTo(0, 1));
+	f.add("min_support_points", minSupportPoints, "... and least number of samples", R::atLeast(3));
+	f.add("below_distance", belowDistance, "a sample this far under a plane is below it [m]", R::positive());
+	f.add("max_below_share", maxBelowShare, "more samples below than this x least support: not the floor", R::atLeast(0));
+	f.add("parallel_planes", parallelPlanes, "tilt from all large horizontal planes (furniture tops), height from the floor");
+	f.add("vertical_planes", verticalPlanes, "with parallel_planes: the normal also perpendicular to large vertical planes (walls)");
+	f.add("min_camera_height", minCameraHeight, "cameras (all but 5 %) at least this high above the floor [m]", R::atLeast(0));
+	f.add("seed", seed, "random seed (reservoir, RANSAC)");
+	return f;
+}
+
 void FloorFrameOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	givenPose = c.read_string(s, "T_world_floor", givenPose.empty() ? "estimate" : givenPose);
-	if (givenPose == "estimate") givenPose.clear();
-	const std::string up = c.read_string(s, "up_hint", "");
-	if (!up.empty())
-	{
-		std::istringstream is(up);
-		double x = 0, y = 0, z = 0;
-		if (!(is >> x >> y >> z))
-			throw std::invalid_argument("[" + s + "] up_hint = '" + up + "' (expected three numbers \"x y z\")");
-		upHint = TVector3D(x, y, z);
-	}
-	initialKeyframes = c.read_int(s, "initial_keyframes", initialKeyframes);
-	reestimateEvery = c.read_int(s, "reestimate_every", reestimateEvery);
-	reservoirSize = c.read_int(s, "reservoir_size", reservoirSize);
-	pixelStep = c.read_int(s, "pixel_step", pixelStep);
-	minDepth = c.read_double(s, "min_depth", minDepth);
-	maxDepth = c.read_double(s, "max_depth", maxDepth);
-	minChange = c.read_double(s, "min_change", minChange);
-	minChangeDeg = c.read_double(s, "min_change_deg", minChangeDeg);
-	inlierDistance = c.read_double(s, "inlier_distance", inlierDistance);
-	hypotheses = c.read_int(s, "hypotheses", hypotheses);
-	rounds = c.read_int(s, "rounds", rounds);
-	maxTiltDeg = c.read_double(s, "max_tilt_deg", maxTiltDeg);
-	refineTiltDeg = c.read_double(s, "refine_tilt_deg", refineTiltDeg);
-	lowestFraction = c.read_double(s, "lowest_fraction", lowestFraction);
-	minSupport = c.read_double(s, "min_support", minSupport);
-	minSupportPoints = c.read_int(s, "min_support_points", minSupportPoints);
-	belowDistance = c.read_double(s, "below_distance", belowDistance);
-	maxBelowShare = c.read_double(s, "max_below_share", maxBelowShare);
-	parallelPlanes = c.read_bool(s, "parallel_planes", parallelPlanes);
-	verticalPlanes = c.read_bool(s, "vertical_planes", verticalPlanes);
-	minCameraHeight = c.read_double(s, "min_camera_height", minCameraHeight);
-	seed = static_cast<uint32_t>(c.read_uint64_t(s, "seed", seed));
+	fields().read(c, s);
 	validate(s);
 }
 
-void FloorFrameOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	char up[96];
-	std::snprintf(up, sizeof(up), "%g %g %g", upHint.x, upHint.y, upHint.z);
-	c.write(s, "T_world_floor", givenPose.empty() ? std::string("estimate") : givenPose, 30, 40,
-			"estimate, or the floor frame given as [x y z yaw pitch roll] (m, deg) in the SLAM world");
-	c.write(s, "up_hint", std::string(up), 30, 40, "\"up\" in the SLAM world for the first search; 0 0 0 = mean -y of the keyframe cameras");
-	c.write(s, "initial_keyframes", initialKeyframes, 30, 40, "estimate at every keyframe until this many contributed (and the floor is found)");
-	c.write(s, "reestimate_every", reestimateEvery, 30, 40, "then re-estimate every N keyframes and after trajectory corrections");
-	c.write(s, "reservoir_size", reservoirSize, 30, 40, "depth samples kept (uniform over all keyframes)");
-	c.write(s, "pixel_step", pixelStep, 30, 40, "depth samples: every n-th pixel in rows and columns");
-	c.write(s, "min_depth", minDepth, 30, 40, "depth range of the samples [m]");
-	c.write(s, "max_depth", maxDepth, 30, 40, "");
-	c.write(s, "min_change", minChange, 30, 40, "smaller moves of the floor [m] ...");
-	c.write(s, "min_change_deg", minChangeDeg, 30, 40, "... and tilts [deg] keep the previous estimate");
-	c.write(s, "inlier_distance", inlierDistance, 30, 40, "point-to-plane distance of a floor inlier [m]");
-	c.write(s, "hypotheses", hypotheses, 30, 40, "RANSAC hypotheses per round");
-	c.write(s, "rounds", rounds, 30, 40, "search rounds; up = the previous round's normal");
-	c.write(s, "max_tilt_deg", maxTiltDeg, 30, 40, "largest angle normal / up hint in the first round [deg]");
-	c.write(s, "refine_tilt_deg", refineTiltDeg, 30, 40, "the same in later rounds [deg]");
-	c.write(s, "lowest_fraction", lowestFraction, 30, 40, "hypotheses from this share of the lowest samples");
-	c.write(s, "min_support", minSupport, 30, 40, "least floor support: share of the samples ...");
-	c.write(s, "min_support_points", minSupportPoints, 30, 40, "... and least number of samples");
-	c.write(s, "below_distance", belowDistance, 30, 40, "a sample this far under a plane is below it [m]");
-	c.write(s, "max_below_share", maxBelowShare, 30, 40, "more samples below than this x least support: not the floor");
-	c.write(s, "parallel_planes", parallelPlanes, 30, 40, "tilt from all large horizontal planes (furniture tops), height from the floor");
-	c.write(s, "vertical_planes", verticalPlanes, 30, 40, "with parallel_planes: the normal also perpendicular to large vertical planes (walls)");
-	c.write(s, "min_camera_height", minCameraHeight, 30, 40, "cameras (all but 5 %) at least this high above the floor [m]");
-	c.write(s, "seed", static_cast<uint64_t>(seed), 30, 40, "random seed (reservoir, RANSAC)");
-}
+void FloorFrameOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
 
 void FloorFrameOptions::validate(const std::string& s) const
 {
-	auto bad = [&](const std::string& key, const std::string& v, const std::string& why) {
-		throw std::invalid_argument("[" + s + "] " + key + " = " + v + " is invalid: " + why);
-	};
-	auto str = [](double v) { return std::to_string(v); };
+	core::validateFields(*this, s);
 	if (!givenPose.empty())
 	{
 		try
@@ -103,28 +88,11 @@ void FloorFrameOptions::validate(const std::string& s) const
 		}
 		catch (const std::exception&)
 		{
-			bad("T_world_floor", givenPose, "expected \"[x y z yaw pitch roll]\" (m, deg)");
+			throw std::invalid_argument("[" + s + "] T_world_floor = '" + givenPose + "' (expected \"[x y z yaw pitch roll]\" (m, deg))");
 		}
 	}
-	if (initialKeyframes < 1) bad("initial_keyframes", str(initialKeyframes), "must be >= 1");
-	if (reestimateEvery < 1) bad("reestimate_every", str(reestimateEvery), "must be >= 1");
-	if (reservoirSize < 100) bad("reservoir_size", str(reservoirSize), "must be >= 100");
-	if (pixelStep < 1) bad("pixel_step", str(pixelStep), "must be >= 1");
-	if (!(minDepth >= 0)) bad("min_depth", str(minDepth), "must be >= 0 m");
-	if (!(maxDepth > minDepth)) bad("max_depth", str(maxDepth), "must exceed min_depth = " + str(minDepth));
-	if (!(minChange >= 0)) bad("min_change", str(minChange), "must be >= 0 m");
-	if (!(minChangeDeg >= 0)) bad("min_change_deg", str(minChangeDeg), "must be >= 0 deg");
-	if (!(inlierDistance > 0)) bad("inlier_distance", str(inlierDistance), "must be > 0 m");
-	if (hypotheses < 1) bad("hypotheses", str(hypotheses), "must be >= 1");
-	if (rounds < 1) bad("rounds", str(rounds), "must be >= 1");
-	if (!(maxTiltDeg > 0 && maxTiltDeg < 90)) bad("max_tilt_deg", str(maxTiltDeg), "must be in (0, 90) deg");
-	if (!(refineTiltDeg > 0 && refineTiltDeg < 90)) bad("refine_tilt_deg", str(refineTiltDeg), "must be in (0, 90) deg");
-	if (!(lowestFraction > 0 && lowestFraction <= 1)) bad("lowest_fraction", str(lowestFraction), "must be in (0, 1]");
-	if (!(minSupport > 0 && minSupport <= 1)) bad("min_support", str(minSupport), "must be in (0, 1]");
-	if (minSupportPoints < 3) bad("min_support_points", str(minSupportPoints), "must be >= 3");
-	if (!(belowDistance > 0)) bad("below_distance", str(belowDistance), "must be > 0 m");
-	if (!(maxBelowShare >= 0)) bad("max_below_share", str(maxBelowShare), "must be >= 0");
-	if (!(minCameraHeight >= 0)) bad("min_camera_height", str(minCameraHeight), "must be >= 0 m");
+	if (!(maxDepth > minDepth))
+		throw std::invalid_argument("[" + s + "] max_depth = " + std::to_string(maxDepth) + " (must be > min_depth = " + std::to_string(minDepth) + ")");
 }
 
 std::optional<mrpt::poses::CPose3D> FloorFrameOptions::given() const
@@ -502,12 +470,14 @@ std::vector<TPoint3Df> FloorFrameEstimator::depthSamples(
 {
 	std::vector<TPoint3Df> out;
 	const int step = o.pixelStep;
+	const core::PinholeIntrinsics K{fx, fy, cx, cy};
 	for (int r = step / 2; r < rows; r += step)
 		for (int c = step / 2; c < cols; c += step)
 		{
 			const float z = depth[static_cast<std::size_t>(r) * cols + c];
 			if (!(z >= o.minDepth && z <= o.maxDepth)) continue;
-			out.emplace_back(static_cast<float>((c - cx) * z / fx), static_cast<float>((r - cy) * z / fy), z);
+			const Eigen::Vector3d p_cam = K.backProject(c, r, z);
+			out.emplace_back(static_cast<float>(p_cam.x()), static_cast<float>(p_cam.y()), z);
 		}
 	return out;
 }

@@ -71,12 +71,13 @@ namespace
 void computePlanes(PreparedKeyframe& p)
 {
 	const auto& c = p.kf->camera;
+	const core::PinholeIntrinsics K = c.pinhole();
 	const double us[4] = {0.0, double(c.width), double(c.width), 0.0};
 	const double vs[4] = {0.0, 0.0, double(c.height), double(c.height)};
 	double r[4][3];
 	for (int i = 0; i < 4; ++i)
-		r[i][0] = (us[i] - c.cx) / c.fx, r[i][1] = (vs[i] - c.cy) / c.fy, r[i][2] = 1.0;
-	const double mid[3] = {(c.width / 2.0 - c.cx) / c.fx, (c.height / 2.0 - c.cy) / c.fy, 1.0};
+		r[i][0] = K.rayX(us[i]), r[i][1] = K.rayY(vs[i]), r[i][2] = 1.0;
+	const double mid[3] = {K.rayX(c.width / 2.0), K.rayY(c.height / 2.0), 1.0};
 	for (int i = 0; i < 4; ++i)
 	{
 		const double* a = r[i];
@@ -138,8 +139,8 @@ VoxelBlockGrid morphAndMerge(const std::vector<const VoxelBlockGrid*>& sources,
 			for (double v : {0.0, double(kf.camera.height)})
 			{
 				// Far corner of the pyramid at depth R (contains the range-limited cone).
-				const mrpt::math::TPoint3D pc(
-					(u - kf.camera.cx) / kf.camera.fx * R, (v - kf.camera.cy) / kf.camera.fy * R, R);
+				const Eigen::Vector3d p_cam = kf.camera.pinhole().backProject(u, v, R);
+				const mrpt::math::TPoint3D pc(p_cam.x(), p_cam.y(), p_cam.z());
 				const auto pw = kf.T_world_cam_new.composePoint(pc);
 				p.lo = {std::min(p.lo.x, pw.x), std::min(p.lo.y, pw.y), std::min(p.lo.z, pw.z)};
 				p.hi = {std::max(p.hi.x, pw.x), std::max(p.hi.y, pw.y), std::max(p.hi.z, pw.z)};

@@ -123,6 +123,7 @@ void markSeenCells(
 			std::to_string(gt.cells.size()));
 	SeenMarker marker(gt, opts);
 	const mrpt::math::TPoint3D c(T_floor_cam.x(), T_floor_cam.y(), T_floor_cam.z());
+	const core::PinholeIntrinsics K = cam.pinhole();
 	for (int v = 0; v < depth.rows; v++)
 	{
 		const float* row = depth.ptr<float>(v);
@@ -130,8 +131,9 @@ void markSeenCells(
 		{
 			const double d = row[u];
 			if (!(d > 0)) continue;
+			const Eigen::Vector3d p_cam = K.backProject(u, v, d);
 			mrpt::math::TPoint3D p;
-			T_floor_cam.composePoint((u - cam.cx) / cam.fx * d, (v - cam.cy) / cam.fy * d, d, p.x, p.y, p.z);
+			T_floor_cam.composePoint(p_cam.x(), p_cam.y(), p_cam.z(), p.x, p.y, p.z);
 			if (p.z >= opts.zMin && p.z <= opts.zMax && std::hypot(p.x - c.x, p.y - c.y) <= opts.maxRange)
 				marker.surface(p);
 			if (u % opts.freeRayStride == 0 && v % opts.freeRayStride == 0) marker.freeSpace(c, p);

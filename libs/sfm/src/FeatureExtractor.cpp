@@ -10,55 +10,39 @@
 
 namespace keygrid::sfm
 {
+core::OptionFields FeatureOptions::fields()
+{
+	using R = core::OptionRule;
+	// Integer ranges also bound memory (keypoints, pyramid images, grid cells per frame).
+	core::OptionFields f;
+	f.add("type", type, "keypoints and descriptors: orb | sift", R::oneOf({"orb", "sift"}));
+	f.add("num_features", numFeatures, "keypoints kept per frame", R::inRange(10, kMaxFeatures));
+	f.add("scale_factor", scaleFactor, "scale step between pyramid levels", R::between(1, 2));
+	f.add("num_levels", numLevels, "pyramid levels", R::inRange(1, 16));
+	f.add("fast_threshold", fastThreshold, "ORB FAST corner threshold [grey levels]", R::inRange(1, 255));
+	f.add("oversampling", oversampling, "candidates per kept keypoint before bucketing", R::inRange(1, 10));
+	f.add("grid_cols", gridCols, "bucketing grid columns", R::inRange(1, 1000));
+	f.add("grid_rows", gridRows, "bucketing grid rows", R::inRange(1, 1000));
+	f.add("min_depth", minDepth, "valid depth range, lower end [m]", R::atLeast(0));
+	f.add("max_depth", maxDepth, "valid depth range, upper end [m] (above min_depth)");
+	f.add("max_depth_discontinuity", maxDepthDiscontinuity, "3x3 depth span / depth above which depth is rejected", R::positive());
+	f.add("pyramid_pixel_centres", pyramidPixelCentres, "ORB: map pyramid keypoints to level 0 through pixel centres");
+	return f;
+}
+
 void FeatureOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	type = c.read_string(s, "type", type);
-	// Integer ranges also bound memory (keypoints, pyramid images, grid cells per frame).
-	numFeatures = static_cast<int>(core::readInteger(c, s, "num_features", numFeatures, 10, kMaxFeatures));
-	scaleFactor = core::readFiniteNumber(c, s, "scale_factor", scaleFactor);
-	numLevels = static_cast<int>(core::readInteger(c, s, "num_levels", numLevels, 1, 16));
-	fastThreshold = static_cast<int>(core::readInteger(c, s, "fast_threshold", fastThreshold, 1, 255));
-	oversampling = core::readFiniteNumber(c, s, "oversampling", oversampling);
-	gridCols = static_cast<int>(core::readInteger(c, s, "grid_cols", gridCols, 1, 1000));
-	gridRows = static_cast<int>(core::readInteger(c, s, "grid_rows", gridRows, 1, 1000));
-	minDepth = core::readFiniteNumber(c, s, "min_depth", minDepth);
-	maxDepth = core::readFiniteNumber(c, s, "max_depth", maxDepth);
-	maxDepthDiscontinuity = core::readFiniteNumber(c, s, "max_depth_discontinuity", maxDepthDiscontinuity);
-	pyramidPixelCentres = core::readBoolean(c, s, "pyramid_pixel_centres", pyramidPixelCentres);
-	std::string err;
-	if (!isValid(&err)) throw std::invalid_argument("[" + s + "] " + err);
+	fields().read(c, s);
+	validate(s);
 }
 
-void FeatureOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	c.write(s, "type", type, 30, 40, "orb | sift");
-	c.write(s, "num_features", numFeatures, 30, 40, "keypoints kept per frame");
-	c.write(s, "scale_factor", scaleFactor, 30, 40, "pyramid scale step");
-	c.write(s, "num_levels", numLevels, 30, 40, "pyramid levels");
-	c.write(s, "fast_threshold", fastThreshold, 30, 40, "ORB FAST threshold");
-	c.write(s, "oversampling", oversampling, 30, 40, "candidates per kept keypoint before bucketing");
-	c.write(s, "grid_cols", gridCols, 30, 40, "bucketing grid columns");
-	c.write(s, "grid_rows", gridRows, 30, 40, "bucketing grid rows");
-	c.write(s, "min_depth", minDepth, 30, 40, "valid depth range, lower end [m]");
-	c.write(s, "max_depth", maxDepth, 30, 40, "valid depth range, upper end [m]");
-	c.write(s, "max_depth_discontinuity", maxDepthDiscontinuity, 30, 40, "3x3 depth span / depth above which depth is rejected");
-	c.write(s, "pyramid_pixel_centres", pyramidPixelCentres, 30, 40, "ORB: map pyramid keypoints to level 0 through pixel centres");
-}
+void FeatureOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
 
-bool FeatureOptions::isValid(std::string* error) const
+void FeatureOptions::validate(const std::string& s) const
 {
-	std::ostringstream e;
-	if (type != "orb" && type != "sift") e << "type = '" << type << "' (expected orb or sift)";
-	else if (numFeatures < 10 || numFeatures > kMaxFeatures) e << "num_features = " << numFeatures << " (must be in [10, " << kMaxFeatures << "])";
-	else if (oversampling > 10.0) e << "oversampling = " << oversampling << " (must be <= 10)";
-	else if (!(scaleFactor > 1.0 && scaleFactor < 2.0)) e << "scale_factor = " << scaleFactor << " (must be in (1, 2))";
-	else if (numLevels < 1 || numLevels > 16) e << "num_levels = " << numLevels << " (must be 1..16)";
-	else if (oversampling < 1.0) e << "oversampling = " << oversampling << " (must be >= 1)";
-	else if (gridCols < 1 || gridRows < 1) e << "grid_cols/grid_rows must be >= 1";
-	else if (!(minDepth >= 0 && maxDepth > minDepth)) e << "min_depth/max_depth = " << minDepth << "/" << maxDepth;
-	else if (!(maxDepthDiscontinuity > 0)) e << "max_depth_discontinuity must be > 0";
-	if (error) *error = e.str();
-	return e.str().empty();
+	core::validateFields(*this, s);
+	if (!(maxDepth > minDepth))
+		throw std::invalid_argument("[" + s + "] max_depth = " + std::to_string(maxDepth) + " (must be > min_depth = " + std::to_string(minDepth) + ")");
 }
 
 std::vector<cv::KeyPoint> bucketKeypoints(
@@ -105,8 +89,7 @@ std::vector<cv::KeyPoint> bucketKeypoints(
 
 FeatureExtractor::FeatureExtractor(const FeatureOptions& o) : m_opts(o)
 {
-	std::string err;
-	if (!o.isValid(&err)) throw std::invalid_argument("FeatureOptions: " + err);
+	o.validate("features");
 	const int n = static_cast<int>(std::ceil(o.numFeatures * o.oversampling));
 	if (o.type == "orb")
 		m_detector = cv::ORB::create(

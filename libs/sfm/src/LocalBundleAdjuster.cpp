@@ -1,3 +1,4 @@
+#include <keygrid/sfm/BundleLevenbergMarquardt.h>
 #include <keygrid/sfm/LocalBundleAdjuster.h>
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -5,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <chrono>
+#include <limits>
 #include <set>
 
 namespace keygrid::sfm
@@ -29,6 +32,13 @@ class AnalyticBaCost final : public ceres::SizedCostFunction<3, 4, 3, 3>
 /** Up to this many optimised keyframes the reduced camera system is solved densely. */
 constexpr std::size_t kAutoDenseMaxKeyFrames = 60;
 
+/** `linear_solver = auto` with analytic Jacobians: Ceres' dense Schur for local windows, the
+ * dedicated sparse solver (BundleLevenbergMarquardt.h) for larger problems. */
+bool usesDedicatedSolver(const BundleAdjusterOptions& o, std::size_t movingKeyFrames)
+{
+	return o.linearSolver == BaLinearSolver::Auto && o.analyticJacobians && movingKeyFrames > kAutoDenseMaxKeyFrames;
+}
+
 const char* solverName(BaLinearSolver s)
 {
 	switch (s)
@@ -41,41 +51,41 @@ const char* solverName(BaLinearSolver s)
 }
 }  // namespace
 
-void BundleAdjusterOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields BundleAdjusterOptions::fields()
 {
-	windowSize = c.read_int(s, "window_size", windowSize);
-	maxFixedKeyFrames = c.read_int(s, "max_fixed_keyframes", maxFixedKeyFrames);
-	iterations = c.read_int(s, "iterations", iterations);
-	functionTolerance = c.read_double(s, "function_tolerance", functionTolerance);
-	threads = c.read_int(s, "threads", threads);
-	analyticJacobians = c.read_bool(s, "analytic_jacobians", analyticJacobians);
-	const std::string solver = c.read_string(s, "linear_solver", solverName(linearSolver));
-	bool known = false;
-	for (auto v : {BaLinearSolver::Auto, BaLinearSolver::DenseSchur, BaLinearSolver::SparseSchur, BaLinearSolver::IterativeSchur})
-		if (solver == solverName(v))
-		{
-			linearSolver = v;
-			known = true;
-		}
-	if (!known)
-		throw std::invalid_argument("[" + s + "] linear_solver = " + solver + " (must be auto, dense_schur, sparse_schur or iterative_schur)");
-	if (windowSize < 1) throw std::invalid_argument("[" + s + "] window_size = " + std::to_string(windowSize) + " (must be >= 1)");
-	if (iterations < 1) throw std::invalid_argument("[" + s + "] iterations = " + std::to_string(iterations) + " (must be >= 1)");
-	if (!(functionTolerance >= 0 && functionTolerance < 1))
-		throw std::invalid_argument("[" + s + "] function_tolerance = " + std::to_string(functionTolerance) + " (must be in [0, 1))");
-	if (threads < 1) throw std::invalid_argument("[" + s + "] threads = " + std::to_string(threads) + " (must be >= 1)");
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("window_size", windowSize, "covisible keyframes optimised with the new one", R::atLeast(1));
+	f.add("max_fixed_keyframes", maxFixedKeyFrames, "fixed keyframes anchoring the window");
+	f.add("iterations", iterations, "Levenberg-Marquardt iterations at most", R::atLeast(1));
+	f.add("function_tolerance", functionTolerance, "stop once an iteration lowers the cost by less than this fraction", R::fromBelow(0, 1));
+	f.add("threads", threads, "Ceres threads (1 = deterministic)", R::atLeast(1));
+	f.add("analytic_jacobians", analyticJacobians, "hand-written Jacobians (false: Ceres autodiff)");
+	f.addCustom(
+		"linear_solver",
+		{[this](const std::string& text) {
+			 for (auto v : {BaLinearSolver::Auto, BaLinearSolver::DenseSchur, BaLinearSolver::SparseSchur, BaLinearSolver::IterativeSchur})
+				 if (text == solverName(v))
+				 {
+					 linearSolver = v;
+					 return;
+				 }
+			 throw std::invalid_argument("expected auto, dense_schur, sparse_schur or iterative_schur");
+		 },
+		 [this] { return std::string(solverName(linearSolver)); }},
+		"Ceres linear solver: auto | dense_schur | sparse_schur | iterative_schur");
+	return f;
 }
 
-void BundleAdjusterOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void BundleAdjusterOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "window_size", windowSize, 30, 40, "covisible keyframes optimised with the new one");
-	c.write(s, "max_fixed_keyframes", maxFixedKeyFrames, 30, 40, "fixed keyframes anchoring the window");
-	c.write(s, "iterations", iterations, 30, 40, "Levenberg-Marquardt iterations at most");
-	c.write(s, "function_tolerance", functionTolerance, 30, 40, "stop once an iteration lowers the cost by less than this fraction");
-	c.write(s, "threads", threads, 30, 40, "Ceres threads (1 = deterministic)");
-	c.write(s, "analytic_jacobians", analyticJacobians, 30, 40, "hand-written Jacobians (false: Ceres autodiff)");
-	c.write(s, "linear_solver", std::string(solverName(linearSolver)), 30, 40, "auto | dense_schur | sparse_schur | iterative_schur");
+	fields().read(c, s);
+	validate(s);
 }
+
+void BundleAdjusterOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
+
+void BundleAdjusterOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 BundleAdjustment BundleAdjustment::around(
 	const SparseMap& map, KeyFrameId kfId, const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
@@ -128,17 +138,26 @@ BundleAdjusterReport bundleAdjust(
 /** The problem owns copies of the parameters; the cost functions own their measurements. */
 struct BundleAdjustment::Problem
 {
+	/** One observation: who, the measurement, and where it is in the problem. */
 	struct Obs
 	{
 		LandmarkId lm;
 		KeyFrameId kf;
 		bool rgbd;
-		ceres::ResidualBlockId block;
+		Eigen::Vector2d uv;  // undistorted pixel
+		double depth;  // measured depth (used when rgbd)
+		double invSigma;  // 1 / sigma of the keypoint's level
+		std::size_t pose, point;  // rows of poses and points
+		ceres::ResidualBlockId block{nullptr};  // Ceres' residual block (Ceres solves only)
 	};
 	BundleAdjusterOptions opts;
+	PinholeIntrinsics K;
+	/** Solved by solveBundleLevenbergMarquardt instead of Ceres (see usesDedicatedSolver). */
+	bool dedicated{false};
 	std::vector<KeyFrameId> local;
 	std::map<KeyFrameId, std::size_t> poseIndex;  // keyframe -> row of poses
 	std::vector<std::array<double, 7>> poses;  // q(x,y,z,w), t of T_cam_world
+	std::vector<char> constant;  // per pose row: a fixed observer or the map's first keyframe
 	std::vector<LandmarkId> lms;  // in id order
 	std::vector<std::array<double, 3>> points;  // in the order of lms
 	std::vector<Obs> all;
@@ -159,10 +178,16 @@ struct BundleAdjustment::Problem
 		po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
 		return po;
 	}
-	explicit Problem(const BundleAdjusterOptions& o)
-		: opts(o), lossMono(std::sqrt(o.chi2Mono)), lossRgbd(std::sqrt(o.chi2Rgbd)), problem(problemOptions())
+	Problem(const BundleAdjusterOptions& o, const PinholeIntrinsics& K_)
+		: opts(o), K(K_), lossMono(std::sqrt(o.chi2Mono)), lossRgbd(std::sqrt(o.chi2Rgbd)), problem(problemOptions())
 	{
 	}
+
+	void buildCeresProblem();
+	void solveWithCeres();
+	void solveDedicated();
+	/** 2 x the unrobustified cost of observation k at the solved parameters: |r|^2. */
+	double squaredResidual(std::size_t k) const;
 };
 
 namespace
@@ -197,7 +222,7 @@ bool depthObservable(const SparseMap& map, LandmarkId id, const BundleAdjusterOp
 BundleAdjustment::BundleAdjustment(
 	const SparseMap& map, const std::vector<KeyFrameId>& local, const std::set<KeyFrameId>& fixedSet,
 	const PinholeIntrinsics& K, const BundleAdjusterOptions& o)
-	: m(std::make_unique<Problem>(o))
+	: m(std::make_unique<Problem>(o, K))
 {
 	m->local = local;
 	auto& rep = m->report;
@@ -231,63 +256,75 @@ BundleAdjustment::BundleAdjustment(
 		m->points.push_back({p.x(), p.y(), p.z()});
 	}
 
-	auto& problem = m->problem;
-	// Schur ordering given explicitly (landmarks eliminated first, then poses), which spares
-	// Ceres the independent-set search over the problem graph.
+	m->constant.assign(m->poses.size(), 0);
 	for (const auto& [id, i] : m->poseIndex)
-	{
-		auto& pq = m->poses[i];
-		problem.AddParameterBlock(pq.data(), 4, new ceres::EigenQuaternionManifold());
-		problem.AddParameterBlock(pq.data() + 4, 3);
-		m->ordering->AddElementToGroup(pq.data(), 1);
-		m->ordering->AddElementToGroup(pq.data() + 4, 1);
 		// Gauge: keyframe 0 defines the world frame and never moves; fixed observers anchor
 		// the window to the rest of the map.
-		if (fixedSet.count(id) || id == map.keyframes().begin()->first)
-		{
-			problem.SetParameterBlockConstant(pq.data());
-			problem.SetParameterBlockConstant(pq.data() + 4);
-		}
-	}
+		m->constant[i] = fixedSet.count(id) || id == map.keyframes().begin()->first;
 	auto& all = m->all;
 	for (std::size_t lmRow = 0; lmRow < m->lms.size(); lmRow++)
 	{
 		const LandmarkId lm = m->lms[lmRow];
-		double* point = m->points[lmRow].data();
+		const double* point = m->points[lmRow].data();
 		for (const auto& [kf, kp] : map.landmark(lm).observations)
 		{
 			const auto pi = m->poseIndex.find(kf);
 			if (pi == m->poseIndex.end()) continue;
-			auto& pq = m->poses[pi->second];
+			const auto& pq = m->poses[pi->second];
 			double u, v, ur;
-			if (!projectRgbd(pq.data(), pq.data() + 4, static_cast<const double*>(point), K, 0.0, u, v, ur))
+			if (!projectRgbd(pq.data(), pq.data() + 4, point, K, 0.0, u, v, ur))
 			{
 				m->behind.emplace_back(lm, kf);
 				continue;
 			}
 			const auto& f = map.keyframe(kf).features;
-			const Eigen::Vector2d uv(f.undistorted[kp].x, f.undistorted[kp].y);
-			const double invSigma = 1.0 / f.levelScale[f.keypoints[kp].octave];
 			const double d = f.depth[kp];
-			const bool rgbd = d > 0 && d < o.maxDepthForRgbd;
-			ceres::CostFunction* cost = nullptr;
-			if (o.analyticJacobians)
-				cost = new AnalyticBaCost(AnalyticReprojectionCost(uv, rgbd ? d : 0.0, o.bf, invSigma, 1.0 / o.disparitySigma, K));
-			else if (rgbd)
-				cost = new ceres::AutoDiffCostFunction<RgbdReprojectionCost, 3, 4, 3, 3>(
-					new RgbdReprojectionCost(uv, d, o.bf, invSigma, 1.0 / o.disparitySigma, K));
-			else
-				cost = new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3>(new MonoReprojectionCost(uv, invSigma, K));
-			const auto block = problem.AddResidualBlock(
-				cost, rgbd ? &m->lossRgbd : &m->lossMono, pq.data(), pq.data() + 4, point);
-			if (all.empty() || all.back().lm != lm) m->ordering->AddElementToGroup(point, 0);
-			all.push_back({lm, kf, rgbd, block});
+			all.push_back({lm, kf, d > 0 && d < o.maxDepthForRgbd, Eigen::Vector2d(f.undistorted[kp].x, f.undistorted[kp].y), d,
+				1.0 / f.levelScale[f.keypoints[kp].octave], pi->second, lmRow});
 		}
 	}
+	m->dedicated = usesDedicatedSolver(o, local.size());
+	if (!m->dedicated) m->buildCeresProblem();
 	rep.keyframes = static_cast<int>(local.size());
 	rep.fixedKeyFrames = static_cast<int>(fixedSet.size());
 	rep.landmarks = static_cast<int>(m->lms.size());
 	rep.observations = static_cast<int>(all.size());
+}
+
+void BundleAdjustment::Problem::buildCeresProblem()
+{
+	// Schur ordering given explicitly (landmarks eliminated first, then poses), which spares
+	// Ceres the independent-set search over the problem graph.
+	for (const auto& [id, i] : poseIndex)
+	{
+		auto& pq = poses[i];
+		problem.AddParameterBlock(pq.data(), 4, new ceres::EigenQuaternionManifold());
+		problem.AddParameterBlock(pq.data() + 4, 3);
+		ordering->AddElementToGroup(pq.data(), 1);
+		ordering->AddElementToGroup(pq.data() + 4, 1);
+		if (constant[i])
+		{
+			problem.SetParameterBlockConstant(pq.data());
+			problem.SetParameterBlockConstant(pq.data() + 4);
+		}
+	}
+	const auto& o = opts;
+	for (std::size_t k = 0; k < all.size(); k++)
+	{
+		auto& ob = all[k];
+		auto& pq = poses[ob.pose];
+		double* point = points[ob.point].data();
+		ceres::CostFunction* cost = nullptr;
+		if (o.analyticJacobians)
+			cost = new AnalyticBaCost(AnalyticReprojectionCost(ob.uv, ob.rgbd ? ob.depth : 0.0, o.bf, ob.invSigma, 1.0 / o.disparitySigma, K));
+		else if (ob.rgbd)
+			cost = new ceres::AutoDiffCostFunction<RgbdReprojectionCost, 3, 4, 3, 3>(
+				new RgbdReprojectionCost(ob.uv, ob.depth, o.bf, ob.invSigma, 1.0 / o.disparitySigma, K));
+		else
+			cost = new ceres::AutoDiffCostFunction<MonoReprojectionCost, 2, 4, 3, 3>(new MonoReprojectionCost(ob.uv, ob.invSigma, K));
+		ob.block = problem.AddResidualBlock(cost, ob.rgbd ? &lossRgbd : &lossMono, pq.data(), pq.data() + 4, point);
+		if (k == 0 || all[k - 1].lm != ob.lm) ordering->AddElementToGroup(point, 0);
+	}
 }
 
 BundleAdjustment::BundleAdjustment(BundleAdjustment&&) noexcept = default;
@@ -296,7 +333,15 @@ BundleAdjustment::~BundleAdjustment() = default;
 void BundleAdjustment::solve()
 {
 	if (m->all.empty()) return;
-	const auto& o = m->opts;
+	if (m->dedicated)
+		m->solveDedicated();
+	else
+		m->solveWithCeres();
+}
+
+void BundleAdjustment::Problem::solveWithCeres()
+{
+	const auto& o = opts;
 	ceres::Solver::Options so;
 	switch (o.linearSolver)
 	{
@@ -308,23 +353,87 @@ void BundleAdjustment::solve()
 			break;
 		default:
 			// The reduced camera system has 6 unknowns per moving keyframe: dense Cholesky is the
-			// fastest for local windows, sparse for large (global) problems.
-			so.linear_solver_type = m->local.size() <= kAutoDenseMaxKeyFrames ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
+			// fastest for local windows, sparse for large problems (autodiff Jacobians).
+			so.linear_solver_type = local.size() <= kAutoDenseMaxKeyFrames ? ceres::DENSE_SCHUR : ceres::SPARSE_SCHUR;
 	}
 	so.sparse_linear_algebra_library_type = ceres::SUITE_SPARSE;
-	so.linear_solver_ordering = m->ordering;
+	so.linear_solver_ordering = ordering;
 	so.max_num_iterations = o.iterations;
 	so.function_tolerance = o.functionTolerance;
 	so.num_threads = o.threads;
 	so.logging_type = ceres::SILENT;
 	ceres::Solver::Summary summary;
-	ceres::Solve(so, &m->problem, &summary);
-	m->report.initialCost = summary.initial_cost;
-	m->report.finalCost = summary.final_cost;
-	m->report.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
-	m->report.solverSeconds = summary.total_time_in_seconds;
-	m->report.evaluationSeconds = summary.residual_evaluation_time_in_seconds + summary.jacobian_evaluation_time_in_seconds;
-	m->report.linearSolverSeconds = summary.linear_solver_time_in_seconds;
+	ceres::Solve(so, &problem, &summary);
+	report.initialCost = summary.initial_cost;
+	report.finalCost = summary.final_cost;
+	report.iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
+	report.solverSeconds = summary.total_time_in_seconds;
+	report.evaluationSeconds = summary.residual_evaluation_time_in_seconds + summary.jacobian_evaluation_time_in_seconds;
+	report.linearSolverSeconds = summary.linear_solver_time_in_seconds;
+}
+
+void BundleAdjustment::Problem::solveDedicated()
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	const auto& o = opts;
+	std::vector<BundleCamera> cameras(poses.size());
+	for (std::size_t i = 0; i < poses.size(); i++)
+	{
+		const auto& pq = poses[i];
+		cameras[i].R_cam_world = Eigen::Quaterniond(pq[3], pq[0], pq[1], pq[2]).normalized().toRotationMatrix();
+		cameras[i].t_cam_world = Eigen::Vector3d(pq[4], pq[5], pq[6]);
+		cameras[i].fixed = constant[i] != 0;
+	}
+	std::vector<Eigen::Vector3d> xyz(points.size());
+	for (std::size_t j = 0; j < points.size(); j++) xyz[j] = Eigen::Vector3d(points[j][0], points[j][1], points[j][2]);
+	std::vector<BundleTerm> terms(all.size());
+	for (std::size_t k = 0; k < all.size(); k++)
+	{
+		const auto& ob = all[k];
+		auto& t = terms[k];
+		t.camera = static_cast<int>(ob.pose);
+		t.point = static_cast<int>(ob.point);
+		t.uv = ob.uv;
+		t.invSigma = ob.invSigma;
+		t.disparity = ob.rgbd ? o.bf / ob.depth : 0.0;
+		t.invSigmaDisparity = 1.0 / o.disparitySigma;
+		t.huberDelta = std::sqrt(ob.rgbd ? o.chi2Rgbd : o.chi2Mono);
+	}
+	BundleSolverOptions so;
+	so.maxIterations = o.iterations;
+	so.functionTolerance = o.functionTolerance;
+	const auto s = solveBundleLevenbergMarquardt(cameras, xyz, terms, K, o.bf, so);
+	for (std::size_t i = 0; i < poses.size(); i++)
+	{
+		if (constant[i]) continue;
+		const Eigen::Quaterniond q = Eigen::Quaterniond(cameras[i].R_cam_world).normalized();
+		poses[i] = {q.x(), q.y(), q.z(), q.w(), cameras[i].t_cam_world.x(), cameras[i].t_cam_world.y(), cameras[i].t_cam_world.z()};
+	}
+	for (std::size_t j = 0; j < points.size(); j++) points[j] = {xyz[j].x(), xyz[j].y(), xyz[j].z()};
+	report.initialCost = s.initialCost;
+	report.finalCost = s.finalCost;
+	report.iterations = s.iterations;
+	report.evaluationSeconds = s.evaluationSeconds;
+	report.linearSolverSeconds = s.linearSolverSeconds;
+	report.solverSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+double BundleAdjustment::Problem::squaredResidual(std::size_t k) const
+{
+	const auto& ob = all[k];
+	if (ob.block)
+	{
+		double cost = 0;
+		problem.EvaluateResidualBlock(ob.block, false, &cost, nullptr, nullptr);
+		// EvaluateResidualBlock(apply_loss_function=false) gives 0.5 |r|^2.
+		return 2.0 * cost;
+	}
+	const auto& pq = poses[ob.pose];
+	const AnalyticReprojectionCost c(ob.uv, ob.rgbd ? ob.depth : 0.0, opts.bf, ob.invSigma, 1.0 / opts.disparitySigma, K);
+	double r[3];
+	if (!c.evaluate(pq.data(), pq.data() + 4, points[ob.point].data(), r, nullptr, nullptr, nullptr))
+		return std::numeric_limits<double>::infinity();
+	return r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
 }
 
 BundleAdjusterReport BundleAdjustment::apply(SparseMap& map)
@@ -354,13 +463,11 @@ BundleAdjusterReport BundleAdjustment::apply(SparseMap& map)
 		}
 	std::vector<double> chi2;
 	chi2.reserve(m->all.size());
-	for (const auto& ob : m->all)
+	for (std::size_t k = 0; k < m->all.size(); k++)
 	{
-		double cost = 0;
-		m->problem.EvaluateResidualBlock(ob.block, false, &cost, nullptr, nullptr);
-		// EvaluateResidualBlock(apply_loss_function=false) gives 0.5 |r|^2.
-		chi2.push_back(2.0 * cost);
-		if (2.0 * cost > (ob.rgbd ? o.chi2Rgbd : o.chi2Mono) && map.hasLandmark(ob.lm))
+		const auto& ob = m->all[k];
+		chi2.push_back(m->squaredResidual(k));
+		if (chi2.back() > (ob.rgbd ? o.chi2Rgbd : o.chi2Mono) && map.hasLandmark(ob.lm))
 		{
 			map.eraseObservation(ob.lm, ob.kf);
 			rep.outliersRemoved++;

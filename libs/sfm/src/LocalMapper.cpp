@@ -10,87 +10,116 @@
 
 namespace keygrid::sfm
 {
-void LocalMapperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields LocalMapperOptions::fields()
 {
-	fuseNeighbours = c.read_int(s, "fuse_neighbours", fuseNeighbours);
-	fuseRadius = c.read_float(s, "fuse_radius", fuseRadius);
-	fuseMaxDistanceOrb = c.read_float(s, "fuse_max_distance_orb", fuseMaxDistanceOrb);
-	minFoundRatio = c.read_double(s, "min_found_ratio", minFoundRatio);
-	redundantKeyFrameRatio = c.read_double(s, "redundant_keyframe_ratio", redundantKeyFrameRatio);
-	triangulationNeighbours = c.read_int(s, "triangulation_neighbours", triangulationNeighbours);
-	minParallaxDeg = c.read_double(s, "min_parallax_deg", minParallaxDeg);
-	localBundleAdjustment = c.read_bool(s, "local_bundle_adjustment", localBundleAdjustment);
-	if (triangulationNeighbours < 0) throw std::invalid_argument("[" + s + "] triangulation_neighbours must be >= 0");
-	if (fuseNeighbours < 0) throw std::invalid_argument("[" + s + "] fuse_neighbours must be >= 0");
-	if (!(redundantKeyFrameRatio > 0 && redundantKeyFrameRatio <= 1.0))
-		throw std::invalid_argument("[" + s + "] redundant_keyframe_ratio = " + std::to_string(redundantKeyFrameRatio) + " (must be in (0, 1])");
-	ba.loadFromConfigFile(c, s);
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("fuse_neighbours", fuseNeighbours, "neighbour keyframes searched for duplicate landmarks", R::atLeast(0));
+	f.add("fuse_radius", fuseRadius, "fusion search radius [px]");
+	f.add("fuse_max_distance_orb", fuseMaxDistanceOrb, "fusion descriptor threshold [Hamming bits]");
+	f.add("min_found_ratio", minFoundRatio, "new landmarks matched in less than this share of their views are culled");
+	f.add("redundant_keyframe_ratio", redundantKeyFrameRatio, "keyframes whose landmarks are this redundant are culled", R::aboveUpTo(0, 1));
+	f.add("triangulation_neighbours", triangulationNeighbours, "keyframes searched for triangulated landmarks", R::atLeast(0));
+	f.add("min_parallax_deg", minParallaxDeg, "smallest parallax of a triangulated landmark [deg]");
+	f.add("local_bundle_adjustment", localBundleAdjustment, "bundle-adjust the covisible window after each keyframe");
+	f.append(ba.fields());
+	return f;
 }
 
-void LocalMapperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void LocalMapperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "fuse_neighbours", fuseNeighbours, 30, 40, "neighbour keyframes searched for duplicates");
-	c.write(s, "fuse_radius", fuseRadius, 30, 40, "fusion search radius [px]");
-	c.write(s, "fuse_max_distance_orb", fuseMaxDistanceOrb, 30, 40, "fusion descriptor threshold [bits]");
-	c.write(s, "min_found_ratio", minFoundRatio, 30, 40, "new landmarks matched less often are culled");
-	c.write(s, "redundant_keyframe_ratio", redundantKeyFrameRatio, 30, 40, "keyframes this redundant are culled");
-	c.write(s, "triangulation_neighbours", triangulationNeighbours, 30, 40, "keyframes searched for triangulated landmarks");
-	c.write(s, "min_parallax_deg", minParallaxDeg, 30, 40, "smallest parallax of a triangulated landmark [deg]");
-	c.write(s, "local_bundle_adjustment", localBundleAdjustment, 30, 40, "");
-	ba.saveToConfigFile(c, s);
+	fields().read(c, s);
+	validate(s);
 }
+
+void LocalMapperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
+
+void LocalMapperOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 LocalMapper::LocalMapper(SparseMap& map, const LocalMapperOptions& opts, const MatcherOptions& matcher)
 	: m_map(map), m_opts(opts), m_matcher(matcher)
 {
 }
 
-LocalMappingReport LocalMapper::process(KeyFrameId kf, const PinholeIntrinsics& K, std::unique_lock<std::mutex>* mapLock)
+LocalMappingPass::LocalMappingPass(KeyFrameId kf) : m_kf(kf), m_stageStart(std::chrono::steady_clock::now()) {}
+
+void LocalMappingPass::lap(const char* stage)
 {
-	LocalMappingReport rep;
-	auto t = std::chrono::steady_clock::now();
-	auto lap = [&](const char* stage) {
-		const auto now = std::chrono::steady_clock::now();
-		rep.stageSeconds.emplace_back(stage, std::chrono::duration<double>(now - t).count());
-		t = now;
-	};
+	const auto now = std::chrono::steady_clock::now();
+	m_report.stageSeconds.emplace_back(stage, std::chrono::duration<double>(now - m_stageStart).count());
+	m_stageStart = now;
+}
+
+void LocalMappingPass::solve()
+{
+	if (m_ba) m_ba->solve();
+}
+
+void LocalMapper::refine(LocalMappingPass& pass, const PinholeIntrinsics& K)
+{
+	const KeyFrameId kf = pass.m_kf;
 	// Landmarks created by this keyframe join the probation list.
 	for (LandmarkId l : m_map.keyframe(kf).landmarks)
 		if (l != kNoLandmark && m_map.hasLandmark(l) && m_map.landmark(l).firstKeyFrame == kf) m_recent.push_back(l);
-	rep.culledLandmarks = cullRecentLandmarks(kf);
-	lap("cull");
-	if (m_map.numKeyFrames() > 1)
+	pass.m_report.culledLandmarks = cullRecentLandmarks(kf);
+	pass.lap("cull");
+	pass.m_refined = m_map.numKeyFrames() > 1;
+	if (!pass.m_refined) return;
+	pass.m_report.triangulated = triangulateNew(kf, K);
+	pass.lap("triangulate");
+	fuse(kf, K, pass.m_report);
+	m_map.updateCovisibility(kf);
+	pass.lap("fuse");
+}
+
+LocalMappingReport LocalMapper::process(KeyFrameId kf, const PinholeIntrinsics& K)
+{
+	LocalMappingPass pass(kf);
+	refine(pass, K);
+	if (pass.m_refined)
 	{
-		rep.triangulated = triangulateNew(kf, K);
-		lap("triangulate");
-		fuse(kf, K, rep);
-		m_map.updateCovisibility(kf);
-		lap("fuse");
-		if (m_opts.localBundleAdjustment && !mapLock)
+		if (m_opts.localBundleAdjustment)
 		{
-			rep.ba = localBundleAdjustment(m_map, kf, K, m_opts.ba);
-			lap("ba");
+			pass.m_report.ba = localBundleAdjustment(m_map, kf, K, m_opts.ba);
+			pass.lap("ba");
 		}
-		else if (m_opts.localBundleAdjustment)
-		{
-			auto ba = BundleAdjustment::around(m_map, kf, K, m_opts.ba);
-			const auto corrections = m_map.corrections();
-			lap("ba_build");
-			mapLock->unlock();
-			ba.solve();
-			mapLock->lock();
-			lap("ba_solve");
-			// Only the mapper erases keyframes, so kf is still there; a loop correction that
-			// happened during the solve would be undone by writing back the old-frame result.
-			if (m_map.corrections() == corrections) rep.ba = ba.apply(m_map);
-			else
-				rep.baDiscarded = true;
-			lap("ba_apply");
-		}
-		rep.culledKeyFrames = cullKeyFrames(kf);
-		lap("cull_keyframes");
+		pass.m_report.culledKeyFrames = cullKeyFrames(kf);
+		pass.lap("cull_keyframes");
 	}
-	return rep;
+	return std::move(pass.m_report);
+}
+
+LocalMappingPass LocalMapper::prepare(KeyFrameId kf, const PinholeIntrinsics& K)
+{
+	LocalMappingPass pass(kf);
+	refine(pass, K);
+	if (pass.m_refined && m_opts.localBundleAdjustment)
+	{
+		pass.m_ba.emplace(BundleAdjustment::around(m_map, kf, K, m_opts.ba));
+		pass.m_correctionsAtBuild = m_map.corrections();
+		pass.lap("ba_build");
+	}
+	return pass;
+}
+
+LocalMappingReport LocalMapper::complete(LocalMappingPass pass)
+{
+	if (pass.m_ba)
+	{
+		pass.lap("ba_solve");
+		// Only the mapper erases keyframes, so the keyframe is still there; a loop correction
+		// during the solve would be undone by writing back the old-frame result.
+		if (m_map.corrections() == pass.m_correctionsAtBuild) pass.m_report.ba = pass.m_ba->apply(m_map);
+		else
+			pass.m_report.baDiscarded = true;
+		pass.lap("ba_apply");
+	}
+	if (pass.m_refined)
+	{
+		pass.m_report.culledKeyFrames = cullKeyFrames(pass.m_kf);
+		pass.lap("cull_keyframes");
+	}
+	return std::move(pass.m_report);
 }
 
 int LocalMapper::triangulateNew(KeyFrameId kfId, const PinholeIntrinsics& K)

@@ -42,7 +42,7 @@ void RollingShutterCompensator::apply(FrameFeatures& f, const CameraRates& rates
 		f.undistorted[i] = m_measured[i];
 		f.depth[i] = d;
 		if (tau == 0.0) continue;
-		const Eigen::Vector3d bearing((m_measured[i].x - K.cx) / K.fx, (m_measured[i].y - K.cy) / K.fy, 1.0);
+		const Eigen::Vector3d bearing = K.ray(m_measured[i].x, m_measured[i].y);
 		const Eigen::Vector3d rot = tau * rates.omega;
 		const double angle = rot.norm();
 		const Eigen::Matrix3d R = angle > 0 ? Eigen::AngleAxisd(angle, rot / angle).toRotationMatrix() : Eigen::Matrix3d::Identity();

@@ -47,13 +47,6 @@ double threadCpuSeconds()
 }
 }  // namespace
 
-Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float d)
-{
-	return {(u - K.cx) / K.fx * d, (v - K.cy) / K.fy * d, static_cast<double>(d)};
-}
-
-PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& c) { return {c.fx, c.fy, c.cx, c.cy}; }
-
 const char* toString(TrackingMethod m)
 {
 	switch (m)
@@ -110,7 +103,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 	cur.frame = &frame;
 	cur.features = std::move(features);
 	cur.matches.assign(cur.features.size(), kNoLandmark);
-	m_K = intrinsicsOf(cur.features.camera);
+	m_K = cur.features.camera.pinhole();
 
 	if (m_state == TrackingState::NotInitialized)
 	{
@@ -324,7 +317,7 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	const auto& f = m_map.keyframe(id).features;
 	for (std::size_t i = 0; i < f.size(); i++)
 		if (f.depth[i] > 0)
-			m_map.addLandmark(backProject(m_K, f.undistorted[i].x, f.undistorted[i].y, f.depth[i]), id, static_cast<int>(i));
+			m_map.addLandmark(m_K.backProject(f.undistorted[i].x, f.undistorted[i].y, f.depth[i]), id, static_cast<int>(i));
 	if (m_hoc) m_hoc->confirmInitialMap(m_map, id);
 	m_refKf = id;
 	m_lastKfFrame = cur.frame->index;
@@ -621,7 +614,7 @@ KeyFrameId Tracker::createKeyFrame(const Current& cur)
 	for (const auto& [d, i] : byDepth)
 	{
 		if (d > m_opts.closeDepth && created >= m_opts.minNewLandmarksPerKeyFrame) break;
-		const Eigen::Vector3d p_cam = backProject(m_K, k.features.undistorted[i].x, k.features.undistorted[i].y, d);
+		const Eigen::Vector3d p_cam = m_K.backProject(k.features.undistorted[i].x, k.features.undistorted[i].y, d);
 		double x, y, z;
 		k.T_world_cam.composePoint(p_cam.x(), p_cam.y(), p_cam.z(), x, y, z);
 		m_map.addLandmark({x, y, z}, id, i);

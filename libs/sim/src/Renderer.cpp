@@ -167,8 +167,9 @@ void Renderer::renderRows(const std::vector<PreparedObject>& objs, int r0, int r
 {
 	const core::RgbdCamera& cam = m_scene.camera;
 	const int W = static_cast<int>(cam.width);
+	const core::PinholeIntrinsics K = cam.pinhole();
 	std::vector<double> rayX(W);
-	for (int x = 0; x < W; x++) rayX[x] = (x - cam.cx) / cam.fx;
+	for (int x = 0; x < W; x++) rayX[x] = K.rayX(x);
 	const bool distorted = !m_rays.empty();
 	// Ray of pixel (x, y) in the optical frame, z = 1.
 	auto ray = [&](int x, int y, double ry) {
@@ -185,7 +186,7 @@ void Renderer::renderRows(const std::vector<PreparedObject>& objs, int r0, int r
 	{
 		std::fill(zbuf.begin(), zbuf.end(), std::numeric_limits<double>::infinity());
 		std::fill(hitObj.begin(), hitObj.end(), -1);
-		const double ry = (y - cam.cy) / cam.fy;
+		const double ry = K.rayY(y);
 		for (std::size_t k = 0; k < objs.size(); k++)
 		{
 			const PreparedObject& p = objs[k];

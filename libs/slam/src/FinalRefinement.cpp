@@ -6,7 +6,7 @@
 
 namespace keygrid::slam
 {
-std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<LoopClosureEvent>& loops, const sfm::SparseMap& map)
+std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<loop::LoopClosureEvent>& loops, const sfm::SparseMap& map)
 {
 	std::vector<sfm::KeyFrameId> seeds;
 	for (auto it = loops.rbegin(); it != loops.rend(); ++it)
@@ -19,7 +19,7 @@ std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<LoopClosureEvent
 }
 
 FinalBundleAdjustment finalBundleAdjustment(
-	sfm::SparseMap& map, const sfm::PinholeIntrinsics& K, const std::vector<LoopClosureEvent>& loops,
+	sfm::SparseMap& map, const sfm::PinholeIntrinsics& K, const std::vector<loop::LoopClosureEvent>& loops,
 	const RefinementOptions& rc, const sfm::LocalMapperOptions& mapping)
 {
 	auto o = mapping.ba;

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <future>
 #include <map>
 #include <regex>
 #include <set>
@@ -15,17 +16,22 @@
 
 namespace keygrid::slam
 {
-void MapFeedOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields MapFeedOptions::fields()
 {
-	ism2dInput = c.read_string(s, "ism2d_input", ism2dInput);
-	if (ism2dInput != "sparse" && ism2dInput != "dense")
-		throw std::invalid_argument("[" + s + "] ism2d_input = '" + ism2dInput + "' (expected sparse or dense)");
+	core::OptionFields f;
+	f.add("ism2d_input", ism2dInput, "input of the 2D ISM grid: sparse (map points) | dense (depth image)", core::OptionRule::oneOf({"sparse", "dense"}));
+	return f;
 }
 
-void MapFeedOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void MapFeedOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "ism2d_input", ism2dInput, 30, 40, "sparse (map points) | dense (depth image)");
+	fields().read(c, s);
+	validate(s);
 }
+
+void MapFeedOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
+
+void MapFeedOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 namespace
 {
@@ -241,12 +247,21 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 	}
 	for (const auto& [id, T] : newPoses)
 		if (m_insertedPoses.count(id)) correction.poses[id] = PoseCorrection{m_insertedPoses.at(id), T};
-	for (std::size_t i = 0; i < m_keyFrameMaps.size(); i++)
+	// The maps are independent of each other: all but the first are re-anchored on threads of
+	// their own (the result does not depend on the order).
+	std::vector<double> seconds(m_keyFrameMaps.size(), -1.0);
+	const auto correct = [&](std::size_t i)
 	{
 		const auto t0 = std::chrono::steady_clock::now();
 		if (m_keyFrameMaps[i]->applyCorrection(correction))
-			out[m_maps.maps[i]->GetRuntimeClass()->className] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-	}
+			seconds[i] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+	};
+	std::vector<std::future<void>> others;
+	for (std::size_t i = 1; i < m_keyFrameMaps.size(); i++) others.push_back(std::async(std::launch::async, correct, i));
+	if (!m_keyFrameMaps.empty()) correct(0);
+	for (auto& f : others) f.get();
+	for (std::size_t i = 0; i < seconds.size(); i++)
+		if (seconds[i] >= 0) out[m_maps.maps[i]->GetRuntimeClass()->className] = seconds[i];
 	for (const auto& [id, T] : newPoses)
 		if (m_insertedPoses.count(id)) m_insertedPoses[id] = T;
 	return out;

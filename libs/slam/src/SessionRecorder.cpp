@@ -1,5 +1,5 @@
 #include <keygrid/core/ConfigReading.h>
-#include <keygrid/slam/LoopCloser.h>
+#include <keygrid/loop/LoopCloser.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SessionRecorder.h>
 #include <keygrid/store/MapSnapshotCodec.h>
@@ -83,35 +83,32 @@ std::uint64_t landmarkHash(const sfm::Landmark& lm, bool withCounters)
 	return f.h;
 }
 
-void SessionRecorderOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields SessionRecorderOptions::fields()
 {
-	images = c.read_bool(s, "images", images);
-	snapshotEvery = static_cast<int>(core::readFiniteNumber(c, s, "snapshot_every", snapshotEvery));
-	if (snapshotEvery < 0) throw std::invalid_argument("[" + s + "] snapshot_every = " + std::to_string(snapshotEvery) + " (must be >= 0)");
-	imageCacheMib = static_cast<int>(core::readFiniteNumber(c, s, "image_cache_mib", imageCacheMib));
-	if (imageCacheMib < 0 || imageCacheMib > (1 << 20))
-		throw std::invalid_argument("[" + s + "] image_cache_mib = " + std::to_string(imageCacheMib) + " (must be in [0, 1048576])");
-	newMapAfterLostFrames = static_cast<int>(core::readFiniteNumber(c, s, "new_map_after_lost_frames", newMapAfterLostFrames));
-	if (newMapAfterLostFrames < 0)
-		throw std::invalid_argument("[" + s + "] new_map_after_lost_frames = " + std::to_string(newMapAfterLostFrames) + " (must be >= 0)");
-	sqlite.loadFromConfigFile(c, s);
-	codec.loadFromConfigFile(c, s);
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("images", images, "store each keyframe's colour and depth images");
+	f.add("snapshot_every", snapshotEvery, "metric-map snapshots every N keyframes (0: at the end only)", R::atLeast(0));
+	f.add("image_cache_mib", imageCacheMib, "RAM for keyframe images out of their keyframes [MiB] (the rest in a spill file)", R::inRange(0, 1 << 20));
+	f.add("new_map_after_lost_frames", newMapAfterLostFrames, "extend mode: lost frames at the start before a new map begins (0: never)", R::atLeast(0));
+	f.append(sqlite.fields());
+	f.append(codec.fields());
+	return f;
 }
 
-void SessionRecorderOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void SessionRecorderOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "images", images, 30, 40, "store each keyframe's colour and depth images");
-	c.write(s, "snapshot_every", snapshotEvery, 30, 40, "metric-map snapshots every N keyframes (0: at the end only)");
-	c.write(s, "image_cache_mib", imageCacheMib, 30, 40, "RAM for keyframe images out of their keyframes [MiB] (the rest in a spill file)");
-	c.write(s, "new_map_after_lost_frames", newMapAfterLostFrames, 30, 40, "extend mode: lost frames at the start before a new map begins (0: never)");
-	sqlite.saveToConfigFile(c, s);
-	codec.saveToConfigFile(c, s);
+	fields().read(c, s);
+	validate(s);
 }
+
+void SessionRecorderOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
+
+void SessionRecorderOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 SessionRecorder::SessionRecorder(const std::string& path, const SessionRecorderOptions& opts) : m_path(path), m_opts(opts)
 {
-	std::string why;
-	if (!opts.sqlite.isValid(&why) || !opts.codec.isValid(&why)) throw std::invalid_argument("[store] " + why);
+	opts.validate("store");
 	if (std::filesystem::exists(path))
 		throw std::runtime_error("session file '" + path + "' exists already (--map creates a new session; --load-map continues one)");
 	const auto dir = std::filesystem::path(path).parent_path();
@@ -138,7 +135,7 @@ SessionRecorder::SessionRecorder(store::SessionStore s, const sfm::SparseMap& lo
 
 SessionRecorder::~SessionRecorder() = default;
 
-void SessionRecorder::open(const sfm::SparseMap& map, const LoopCloser* loop)
+void SessionRecorder::open(const sfm::SparseMap& map, const loop::LoopCloser* loop)
 {
 	if (m_writer) return;
 	store::SessionMeta meta;
@@ -153,7 +150,7 @@ void SessionRecorder::open(const sfm::SparseMap& map, const LoopCloser* loop)
 	m_writer = std::make_unique<store::SessionWriter>(store::SessionStore::Create(m_path, meta, m_opts.sqlite), wo);
 }
 
-store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const LoopCloser* loop, bool withCounters)
+store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const loop::LoopCloser* loop, bool withCounters)
 {
 	store::SessionWriteJob job;
 	auto& u = job.update;
@@ -169,7 +166,7 @@ store::SessionWriteJob SessionRecorder::diff(const sfm::SparseMap& map, const Lo
 	return job;
 }
 
-void SessionRecorder::diffKeyFrames(const sfm::SparseMap& map, const LoopCloser* loop, store::SessionWriteJob& job)
+void SessionRecorder::diffKeyFrames(const sfm::SparseMap& map, const loop::LoopCloser* loop, store::SessionWriteJob& job)
 {
 	auto& u = job.update;
 	for (const auto& [id, kf] : map.keyframes())
@@ -193,7 +190,7 @@ void SessionRecorder::diffKeyFrames(const sfm::SparseMap& map, const LoopCloser*
 	}
 }
 
-void SessionRecorder::addNewKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, const LoopCloser* loop, store::SessionWriteJob& job)
+void SessionRecorder::addNewKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, const loop::LoopCloser* loop, store::SessionWriteJob& job)
 {
 	const loop::BowVector* bow = loop ? loop->bowOf(id) : nullptr;
 	job.update.keyframes.push_back(store::toRecord(kf, bow ? *bow : loop::BowVector{}));
@@ -272,7 +269,7 @@ void SessionRecorder::addSnapshots(store::SessionUpdate& u, const sfm::SparseMap
 	m_keyframesSinceSnapshot = 0;
 }
 
-void SessionRecorder::afterKeyFrame(const sfm::SparseMap& map, const LoopCloser* loop, const LoopClosureEvent* closed, const MetricMaps* maps)
+void SessionRecorder::afterKeyFrame(const sfm::SparseMap& map, const loop::LoopCloser* loop, const loop::LoopClosureEvent* closed, const MetricMaps* maps)
 {
 	const auto t0 = std::chrono::steady_clock::now();
 	open(map, loop);
@@ -296,7 +293,7 @@ void SessionRecorder::afterKeyFrame(const sfm::SparseMap& map, const LoopCloser*
 	m_writer->submit(std::move(job));
 }
 
-void SessionRecorder::finish(const sfm::SparseMap& map, const LoopCloser* loop, const MetricMaps* maps)
+void SessionRecorder::finish(const sfm::SparseMap& map, const loop::LoopCloser* loop, const MetricMaps* maps)
 {
 	if (m_finished) return;
 	m_finished = true;

@@ -18,35 +18,59 @@ RunMode runModeFromString(const std::string& text, const std::string& what)
 	throw std::invalid_argument(what + " '" + text + "' (expected sequential or threaded)");
 }
 
+core::OptionFields RefinementOptions::fields()
+{
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("global_bundle_adjustment", globalBundleAdjustment, "bundle-adjust everything after the last frame");
+	f.add("global_iterations", globalIterations, "upper bound on its iterations (it stops on convergence)", R::atLeast(1));
+	f.add("global_max_keyframes", globalMaxKeyFrames, "keyframes it moves at most: around the loops and the newest (0 = all)", R::atLeast(0));
+	f.add("refine_frames", refineFrames, "re-estimate every frame that is not a keyframe against the final map");
+	f.add("map_reanchor_min_shift", mapReanchorMinShift, "re-anchor the maps only if a keyframe moved more than this [m]", R::atLeast(0));
+	f.add("map_reanchor_depth", mapReanchorDepth, "...measured also at this depth ahead of the camera [m]", R::atLeast(0));
+	return f;
+}
+
+void RefinementOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	fields().read(c, s);
+	validate(s);
+}
+
+void RefinementOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
+
+void RefinementOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
+
+core::OptionFields SlamConfig::fields()
+{
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.addCustom(
+		"mode",
+		{[this](const std::string& text) {
+			 if (text != toString(RunMode::Sequential) && text != toString(RunMode::Threaded))
+				 throw std::invalid_argument("expected sequential or threaded");
+			 mode = runModeFromString(text, "[slam] mode =");
+		 },
+		 [this] { return std::string(toString(mode)); }},
+		"sequential | threaded", R::oneOf({"sequential", "threaded"}));
+	f.addCustom(
+		"camera", {[this](const std::string& text) { camera = text; }, [this] { return camera.empty() ? std::string("auto") : camera; }},
+		"preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
+	f.add("mapping_lag", mappingLag, "threaded: keyframes local mapping may lag behind tracking (0: none)", R::inRange(0, 5));
+	f.add("busy_keyframe_ratio", busyKeyFrameRatio, "threaded, lag > 0: no keyframe while mapping is busy unless tracking < this x reference (0: off)", R::inRange(0, 1));
+	return f;
+}
+
 void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 {
-	const std::string modeText = c.read_string("slam", "mode", toString(mode));
-	camera = c.read_string("slam", "camera", camera);
-	mappingLag = c.read_int("slam", "mapping_lag", mappingLag);
-	busyKeyFrameRatio = c.read_double("slam", "busy_keyframe_ratio", busyKeyFrameRatio);
-	if (!(busyKeyFrameRatio >= 0 && busyKeyFrameRatio <= 1))
-		throw std::invalid_argument("[slam] busy_keyframe_ratio = " + std::to_string(busyKeyFrameRatio) + " (expected 0..1)");
-	mode = runModeFromString(modeText, "[slam] mode =");
-	if (mappingLag < 0 || mappingLag > 5)
-		throw std::invalid_argument("[slam] mapping_lag = " + std::to_string(mappingLag) + " (expected 0..5)");
+	fields().read(c, "slam");
+	core::validateFields(*this, "slam");
 	features.loadFromConfigFile(c, "features");
 	tracker.loadFromConfigFile(c, "tracker");
 	tracker.hoc.loadFromConfigFile(c, "hoc");
 	mapping.loadFromConfigFile(c, "mapping");
-	refinement.globalBundleAdjustment = c.read_bool("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment);
-	refinement.globalIterations = c.read_int("refinement", "global_iterations", refinement.globalIterations);
-	refinement.refineFrames = c.read_bool("refinement", "refine_frames", refinement.refineFrames);
-	if (refinement.globalIterations < 1)
-		throw std::invalid_argument("[refinement] global_iterations = " + std::to_string(refinement.globalIterations) + " (must be >= 1)");
-	refinement.globalMaxKeyFrames = c.read_int("refinement", "global_max_keyframes", refinement.globalMaxKeyFrames);
-	refinement.mapReanchorMinShift = c.read_double("refinement", "map_reanchor_min_shift", refinement.mapReanchorMinShift);
-	refinement.mapReanchorDepth = c.read_double("refinement", "map_reanchor_depth", refinement.mapReanchorDepth);
-	if (refinement.globalMaxKeyFrames < 0)
-		throw std::invalid_argument("[refinement] global_max_keyframes = " + std::to_string(refinement.globalMaxKeyFrames) + " (must be >= 0; 0 = every keyframe)");
-	if (!(refinement.mapReanchorMinShift >= 0))
-		throw std::invalid_argument("[refinement] map_reanchor_min_shift = " + std::to_string(refinement.mapReanchorMinShift) + " (must be >= 0 m)");
-	if (!(refinement.mapReanchorDepth >= 0))
-		throw std::invalid_argument("[refinement] map_reanchor_depth = " + std::to_string(refinement.mapReanchorDepth) + " (must be >= 0 m)");
+	refinement.loadFromConfigFile(c, "refinement");
 	maps.loadFromConfigFile(c, "maps");
 	floor.loadFromConfigFile(c, "floor");
 	loop.loadFromConfigFile(c, "loop_closing");
@@ -58,24 +82,16 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 
 void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 {
-	c.write("slam", "mode", std::string(toString(mode)), 30, 40, "sequential | threaded");
-	c.write("slam", "camera", camera.empty() ? std::string("auto") : camera, 30, 40, "preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
-	c.write("slam", "mapping_lag", mappingLag, 30, 40, "threaded: keyframes local mapping may lag behind tracking (0: none)");
-	c.write("slam", "busy_keyframe_ratio", busyKeyFrameRatio, 30, 40, "threaded, lag > 0: no keyframe while mapping is busy unless tracking < this x reference (0: off)");
+	core::writeFields(*this, c, "slam");
 	features.saveToConfigFile(c, "features");
 	tracker.saveToConfigFile(c, "tracker");
 	tracker.hoc.saveToConfigFile(c, "hoc");
 	mapping.saveToConfigFile(c, "mapping");
-	c.write("refinement", "global_bundle_adjustment", refinement.globalBundleAdjustment, 30, 40, "bundle-adjust everything after the last frame");
-	c.write("refinement", "global_iterations", refinement.globalIterations, 30, 40, "upper bound on its iterations (it stops on convergence)");
-	c.write("refinement", "global_max_keyframes", refinement.globalMaxKeyFrames, 30, 40, "keyframes it moves at most: around the loops and the newest (0 = all)");
+	refinement.saveToConfigFile(c, "refinement");
 	maps.saveToConfigFile(c, "maps");
 	floor.saveToConfigFile(c, "floor");
 	loop.saveToConfigFile(c, "loop_closing");
 	store.saveToConfigFile(c, "store");
-	c.write("refinement", "refine_frames", refinement.refineFrames, 30, 40, "re-estimate every frame that is not a keyframe against the final map");
-	c.write("refinement", "map_reanchor_min_shift", refinement.mapReanchorMinShift, 30, 40, "re-anchor the maps only if a keyframe moved more than this [m]");
-	c.write("refinement", "map_reanchor_depth", refinement.mapReanchorDepth, 30, 40, "...measured also at this depth ahead of the camera [m]");
 }
 
 namespace

@@ -29,7 +29,7 @@ System::System(const SlamConfig& cfg)
 {
 	if (cfg.loop.enabled)
 	{
-		m_loopCloser = std::make_unique<LoopCloser>(m_map, m_mapper, cfg.loop, cfg.tracker.matcher, cfg.features.type);
+		m_loopCloser = std::make_unique<loop::LoopCloser>(m_map, m_mapper, cfg.loop, cfg.tracker.matcher, cfg.features.type);
 		// Relocalization asks the loop closer's keyframe database (vocabulary tree) first.
 		m_tracker.setPlaceRecognizer([this](const sfm::FrameFeatures& f, int n) { return m_loopCloser->placeCandidates(f.descriptors, n); });
 	}
@@ -156,7 +156,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	const KeyFrameJob job{tf.keyframe, tf.index, m_travelled, K};
 	if (tf.newKeyFrame && !m_mappingQueue)
 	{
-		mapKeyFrame(job, nullptr);
+		mapKeyFrame(job);
 		insertAndCloseLoops(job, &tf);
 	}
 	if (m_extending && !m_startedInStoredMap && !m_startedNewMap) startExtending(tf);
@@ -190,11 +190,30 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	return m_frames.back();
 }
 
-void System::mapKeyFrame(const KeyFrameJob& job, std::unique_lock<std::mutex>* mapLock)
+void System::mapKeyFrame(const KeyFrameJob& job)
 {
 	const auto t0 = std::chrono::steady_clock::now();
-	const auto rep = m_mapper.process(job.keyframe, job.K, mapLock);
-	m_timings.add("local_mapping", secondsSince(t0));
+	const auto rep = m_mapper.process(job.keyframe, job.K);
+	recordLocalMapping(rep, secondsSince(t0));
+}
+
+bool System::mapKeyFrameConcurrently(const KeyFrameJob& job)
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	std::unique_lock<std::mutex> lock(m_map.mutex());
+	if (!m_map.hasKeyFrame(job.keyframe)) return false;
+	auto pass = m_mapper.prepare(job.keyframe, job.K);
+	lock.unlock();
+	pass.solve();  // on the pass's copies: tracking and loop closing go on meanwhile
+	lock.lock();
+	const auto rep = m_mapper.complete(std::move(pass));
+	recordLocalMapping(rep, secondsSince(t0));
+	return true;
+}
+
+void System::recordLocalMapping(const sfm::LocalMappingReport& rep, double seconds)
+{
+	m_timings.add("local_mapping", seconds);
 	for (const auto& [stage, sec] : rep.stageSeconds) m_timings.add("local_mapping:" + stage, sec);
 	std::lock_guard<std::mutex> lk(m_statsMutex);
 	m_stats.keyframesCreated++;
@@ -290,7 +309,7 @@ void System::insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 	m_loops.push_back(*ev);
 }
 
-std::optional<LoopClosureEvent> System::closeLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
+std::optional<loop::LoopClosureEvent> System::closeLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf)
 {
 	if (!m_loopCloser) return std::nullopt;
 	const auto t0 = std::chrono::steady_clock::now();
@@ -355,11 +374,8 @@ void System::mappingThread()
 	{
 		while (auto job = m_mappingQueue->pop())
 		{
-			std::unique_lock<std::mutex> lock(m_map.mutex());
 			// A keyframe still queued may have been culled as redundant meanwhile.
-			const bool exists = m_map.hasKeyFrame(job->keyframe);
-			if (exists) mapKeyFrame(*job, &lock);
-			lock.unlock();
+			const bool exists = mapKeyFrameConcurrently(*job);
 			jobDone();
 			if (exists && !m_loopQueue->push(*job)) break;
 		}

@@ -9,39 +9,32 @@
 
 namespace keygrid::store
 {
-bool ImageCodecOptions::isValid(std::string* error) const
+core::OptionFields ImageCodecOptions::fields()
 {
-	const auto bad = [&](const std::string& why) {
-		if (error) *error = why;
-		return false;
-	};
-	if (colourFormat != "png" && colourFormat != "jpg") return bad("colour_format must be png or jpg, got '" + colourFormat + "'");
-	if (pngCompression < 0 || pngCompression > 9)
-		return bad("png_compression must be in 0..9, got " + std::to_string(pngCompression));
-	if (jpegQuality < 1 || jpegQuality > 100) return bad("jpeg_quality must be in 1..100, got " + std::to_string(jpegQuality));
-	return true;
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("colour_format", colourFormat, "png (lossless) | jpg", R::oneOf({"png", "jpg"}));
+	f.add("png_compression", pngCompression, "zlib level of the PNGs", R::inRange(0, 9));
+	f.add("jpeg_quality", jpegQuality, "JPEG quality of the colour images when colour_format = jpg", R::inRange(1, 100));
+	return f;
 }
+
+void ImageCodecOptions::validate(const std::string& section) const { core::validateFields(*this, section); }
 
 void ImageCodecOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section)
 {
-	colourFormat = cfg.read_string(section, "colour_format", colourFormat);
-	pngCompression = static_cast<int>(core::readFiniteNumber(cfg, section, "png_compression", pngCompression));
-	jpegQuality = static_cast<int>(core::readFiniteNumber(cfg, section, "jpeg_quality", jpegQuality));
-	std::string why;
-	if (!isValid(&why)) throw std::invalid_argument("[" + section + "] " + why);
+	fields().read(cfg, section);
+	validate(section);
 }
 
 void ImageCodecOptions::saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const
 {
-	cfg.write(section, "colour_format", colourFormat, 30, 40, "png (lossless) | jpg");
-	cfg.write(section, "png_compression", pngCompression, 30, 40, "zlib level of the PNGs, 0..9");
-	cfg.write(section, "jpeg_quality", jpegQuality, 30, 40, "1..100, colour_format = jpg");
+	core::writeFields(*this, cfg, section);
 }
 
 KeyFrameImageCodec::KeyFrameImageCodec(const ImageCodecOptions& opts) : m_opts(opts)
 {
-	std::string why;
-	if (!m_opts.isValid(&why)) throw std::invalid_argument("KeyFrameImageCodec: " + why);
+	m_opts.validate();
 }
 
 EncodedImages KeyFrameImageCodec::encode(const cv::Mat& colour, const cv::Mat& depthRaw) const

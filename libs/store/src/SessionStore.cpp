@@ -107,8 +107,7 @@ void applyPragmas(detail::SqliteDb& db, const SessionStoreOptions& opts, bool wr
 
 void validateOptions(const SessionStoreOptions& opts)
 {
-	std::string why;
-	if (!opts.isValid(&why)) throw std::invalid_argument("SessionStoreOptions: " + why);
+	opts.validate();
 }
 
 /** Application id, schema version and (when quickCheck) SQLite's structural check, in that

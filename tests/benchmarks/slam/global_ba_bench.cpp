@@ -23,6 +23,7 @@
 #include <mrpt/config/CConfigFileMemory.h>
 
 #include <chrono>
+#include <map>
 #include <cstdio>
 #include <iostream>
 
@@ -60,16 +61,20 @@ int main(int argc, char** argv)
 			sfm::SparseMap map;
 			slam::loadSparseMap(session, map);
 			const double ateBefore = eval::evaluateTrajectory(gt, keyframeTrajectory(map)).ate.rmse;
+			std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> before, after;
+			for (const auto& [id, kf] : map.keyframes()) before[id] = kf.T_world_cam;
 			const auto t0 = std::chrono::steady_clock::now();
 			const auto ba = slam::finalBundleAdjustment(map, K, {}, cfg.refinement, cfg.mapping);
 			const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 			const double ateAfter = eval::evaluateTrajectory(gt, keyframeTrajectory(map)).ate.rmse;
+			for (const auto& [id, kf] : map.keyframes()) after[id] = kf.T_world_cam;
+			const double moved = slam::largestDisplacement(before, after, cfg.refinement.mapReanchorDepth);
 			const auto& rep = ba.report;
 			std::printf(
-				"keyframes %d landmarks %d (left out %d) observations %d | %.3f s (ceres %.3f: evaluation %.3f, linear solver %.3f) "
-				"iterations %d | cost %.1f -> %.1f | keyframe ATE %.2f -> %.2f mm\n",
+				"keyframes %d landmarks %d (left out %d) observations %d | %.3f s (solver %.3f: evaluation %.3f, linear solver %.3f) "
+				"iterations %d | cost %.1f -> %.1f | keyframe ATE %.2f -> %.2f mm | largest keyframe shift %.1f mm\n",
 				rep.keyframes, rep.landmarks, rep.landmarksLeftOut, rep.observations, s, rep.solverSeconds, rep.evaluationSeconds,
-				rep.linearSolverSeconds, rep.iterations, rep.initialCost, rep.finalCost, 1e3 * ateBefore, 1e3 * ateAfter);
+				rep.linearSolverSeconds, rep.iterations, rep.initialCost, rep.finalCost, 1e3 * ateBefore, 1e3 * ateAfter, 1e3 * moved);
 		}
 		return 0;
 	}

@@ -21,6 +21,7 @@ inline bool depthOfScan(const mrpt::obs::CObservation3DRangeScan& o, cv::Mat& de
 	cam.width = static_cast<unsigned>(cols);
 	cam.height = static_cast<unsigned>(rows);
 	depth.create(rows, cols, CV_32FC1);
+	const core::PinholeIntrinsics K = cam.pinhole();
 	for (int r = 0; r < rows; ++r)
 	{
 		float* d = depth.ptr<float>(r);
@@ -29,7 +30,7 @@ inline bool depthOfScan(const mrpt::obs::CObservation3DRangeScan& o, cv::Mat& de
 			float z = o.rangeImage(r, c) * o.rangeUnits;
 			if (!o.range_is_depth && z > 0)
 			{
-				const double xn = (c - cam.cx) / cam.fx, yn = (r - cam.cy) / cam.fy;
+				const double xn = K.rayX(c), yn = K.rayY(r);
 				z = static_cast<float>(z / std::sqrt(1.0 + xn * xn + yn * yn));
 			}
 			d[c] = z;

@@ -59,7 +59,7 @@ std::string framesCsv(const System& sys)
 }
 
 /** Why each keyframe did or did not close a loop (doc/loop-closure.md, "Diagnostics"). */
-std::string loopQueriesCsv(const LoopCloser& loop)
+std::string loopQueriesCsv(const loop::LoopCloser& loop)
 {
 	std::ostringstream csv;
 	csv << "keyframe,frame,outcome,reference_score,candidates,best_candidate,best_score,verified_candidate,matches,inliers,query_ms,seen_through\n";

@@ -2,7 +2,13 @@
 /** \file RgbdCamera.h
  * Intrinsics of a registered RGB-D camera (depth already aligned to the colour image, as in
  * TUM RGB-D, ICL-NUIM and Kinect/OpenNI2 with registration on) and the depth unit.
+ *
+ * Two camera types, on purpose: this one is the sensor as configured and recorded (size,
+ * distortion, depth unit, name; INI and MRPT TCamera I/O); core::PinholeIntrinsics is the model
+ * of the undistorted image alone, which back-projection and the frontend's costs need (four
+ * doubles, copied into every cost functor). pinhole() is the one conversion.
  */
+#include <keygrid/core/PinholeIntrinsics.h>
 #include <mrpt/img/TCamera.h>
 
 #include <array>
@@ -34,6 +40,8 @@ struct RgbdCamera
 	float depthUnits{0.0002f};
 
 	bool hasDistortion() const;
+	/** The pinhole model of the undistorted image (back-projection, rays): the one conversion. */
+	PinholeIntrinsics pinhole() const { return {fx, fy, cx, cy}; }
 
 	/** Named presets: "kinect", "fr1", "fr2", "fr3", "icl" (TUM / ICL-NUIM calibrations).
 	 * Throws std::invalid_argument naming the preset when unknown. */

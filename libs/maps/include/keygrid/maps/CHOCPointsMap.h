@@ -61,6 +61,8 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 		/** Prune after each inserted observation (Default: true) */
 		bool prune{true};
 
+		/** Its keys (OptionFields.h). */
+		core::OptionFields fields();
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 	};
@@ -74,6 +76,8 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 		double sigma{0.05};  //!< [m] (Default: 0.05)
 		double outlierProbability{0.05};  //!< floor of a pixel's likelihood (Default: 0.05)
 
+		/** Its keys (OptionFields.h). */
+		core::OptionFields fields();
 		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 	};

@@ -11,6 +11,7 @@
  * cameras (the mean of their -y axes) or from the INI (up_hint), and the whole frame can be
  * given instead of estimated (T_world_floor).
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/maps/FloorPlaneEstimator.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/TPoint3D.h>
@@ -92,11 +93,12 @@ struct FloorFrameOptions
 	/** Random seed of the reservoir and of RANSAC (Default: 1) */
 	uint32_t seed{1};
 
-	/** Keys (`T_world_floor` = estimate | [x y z yaw pitch roll], `up_hint`,
-	 * `initial_keyframes`, ...) in `section`. */
+	/** The [floor] keys (`T_world_floor` = estimate | [x y z yaw pitch roll], `up_hint`,
+	 * `initial_keyframes`, ...). */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& section) const;
-	/** Throws std::invalid_argument naming the key of a bad value (and `section`). */
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "floor") const;
 	/** givenPose parsed; nullopt when empty. */
 	std::optional<mrpt::poses::CPose3D> given() const;

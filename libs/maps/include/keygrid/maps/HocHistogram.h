@@ -13,6 +13,7 @@
  * Use: a point takes part in data association and pose estimation from a camera in bin b only
  * while p(n_b) > select_threshold; it is removed from the map when max_b p(n_b) < prune_threshold.
  */
+#include <keygrid/core/OptionFields.h>
 #include <mrpt/config/CLoadableOptions.h>
 
 #include <cstdint>
@@ -65,7 +66,10 @@ struct HocOptions : public mrpt::config::CLoadableOptions
 	/** Bin weight p(n). */
 	double weight(int n) const;
 	/** Throws std::invalid_argument naming the first invalid field. */
-	void validate() const;
+	/** The HOC keys ([hoc], and the hocPointsMap plugin's creationOpts). */
+	keygrid::core::OptionFields fields();
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "hoc") const;
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 	void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 };

@@ -4,6 +4,7 @@
  * grid bucketing, undistorted, with a validated depth per keypoint.
  */
 #include <keygrid/core/Frame.h>
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/FrameFeatures.h>
 #include <opencv2/features2d.hpp>
 
@@ -44,9 +45,12 @@ struct FeatureOptions
 	 * OpenCV's u_l * scale^l, which is off by up to 1.3 px at level 7 (Default: true) */
 	bool pyramidPixelCentres{true};
 
+	/** The [features] keys. */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
-	bool isValid(std::string* error = nullptr) const;
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "features") const;
 };
 
 class FeatureExtractor

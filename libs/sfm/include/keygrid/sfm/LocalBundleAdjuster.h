@@ -2,9 +2,10 @@
 /** \file LocalBundleAdjuster.h
  * Local bundle adjustment around a keyframe: the keyframe and its covisible neighbours and all
  * landmarks they see are optimised; keyframes that also see those landmarks stay fixed.
- * Ceres, Huber loss, analytic Jacobians, Schur complement (dense for local windows, SuiteSparse
- * for large problems).
+ * Huber loss, analytic Jacobians, Schur complement: Ceres (dense) for local windows, the
+ * dedicated sparse solver of BundleLevenbergMarquardt.h for large problems.
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/PoseOptimizer.h>
 #include <keygrid/sfm/SparseMap.h>
 
@@ -23,7 +24,8 @@ namespace keygrid::sfm
 /** Linear solver of the Levenberg-Marquardt steps (all eliminate the landmarks first). */
 enum class BaLinearSolver
 {
-	/** DenseSchur up to 60 optimised keyframes, SparseSchur above */
+	/** Ceres' DenseSchur up to 60 optimised keyframes; above, the dedicated sparse solver
+	 * (BundleLevenbergMarquardt.h; Ceres' SparseSchur with autodiff Jacobians) */
 	Auto,
 	/** Dense Cholesky of the reduced camera system */
 	DenseSchur,
@@ -69,8 +71,12 @@ struct BundleAdjusterOptions
 	 * iterative_schur (Default: auto) */
 	BaLinearSolver linearSolver{BaLinearSolver::Auto};
 
+	/** The bundle adjustment's keys (in [mapping]). */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "mapping") const;
 };
 
 struct BundleAdjusterReport

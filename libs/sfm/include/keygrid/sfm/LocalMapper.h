@@ -8,8 +8,10 @@
 #include <keygrid/sfm/Matcher.h>
 #include <keygrid/sfm/SparseMap.h>
 
+#include <chrono>
+#include <cstdint>
 #include <deque>
-#include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -43,8 +45,12 @@ struct LocalMapperOptions
 	bool localBundleAdjustment{true};
 	BundleAdjusterOptions ba;
 
+	/** The [mapping] keys, the local bundle adjustment's included. */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "mapping") const;
 };
 
 struct LocalMappingReport
@@ -59,15 +65,47 @@ struct LocalMappingReport
 	std::vector<std::pair<std::string, double>> stageSeconds;
 };
 
+/** Local mapping of one keyframe, split where its bundle adjustment is solved (threaded mode):
+ * LocalMapper::prepare() and LocalMapper::complete() read and write the map, so their caller
+ * holds SparseMap::mutex(); solve() works on the pass's own copies, so the caller releases
+ * that lock around it and tracking goes on meanwhile. */
+class LocalMappingPass
+{
+   public:
+	/** Solves the local bundle adjustment, if prepare() built one; touches no map. */
+	void solve();
+
+   private:
+	friend class LocalMapper;
+	explicit LocalMappingPass(KeyFrameId kf);
+	/** Ends stage `stage` of the report's stageSeconds and starts the next. */
+	void lap(const char* stage);
+
+	KeyFrameId m_kf;
+	LocalMappingReport m_report;
+	/** The map had another keyframe: the steps after culling ran, and keyframes are culled */
+	bool m_refined{false};
+	std::optional<BundleAdjustment> m_ba;
+	std::uint64_t m_correctionsAtBuild{0};  //!< SparseMap::corrections() when m_ba was built
+	std::chrono::steady_clock::time_point m_stageStart;
+};
+
 class LocalMapper
 {
    public:
 	LocalMapper(SparseMap& map, const LocalMapperOptions& opts, const MatcherOptions& matcher);
 
-	/** Processes a keyframe just created by the Tracker. In threaded mode the caller passes
-	 * its lock on map.mutex() (held on entry and on return): the bundle adjustment is then
-	 * solved with the lock released, so tracking goes on meanwhile. */
-	LocalMappingReport process(KeyFrameId kf, const PinholeIntrinsics& K, std::unique_lock<std::mutex>* mapLock = nullptr);
+	/** Processes a keyframe just created by the Tracker, in one go (sequential mode; the
+	 * caller holds the map's lock when other threads use the map). */
+	LocalMappingReport process(KeyFrameId kf, const PinholeIntrinsics& K);
+
+	/** The same as process() in phases (LocalMappingPass): everything up to the bundle
+	 * adjustment, which is copied out of the map... */
+	LocalMappingPass prepare(KeyFrameId kf, const PinholeIntrinsics& K);
+	/** ...and, after LocalMappingPass::solve(), its result written back and keyframes culled.
+	 * A loop correction since prepare() (SparseMap::corrections()) drops the result
+	 * (LocalMappingReport::baDiscarded): it was solved in the old frame. */
+	LocalMappingReport complete(LocalMappingPass pass);
 
 	/** Projects landmarks `lms` into keyframe `target`, merging duplicates and adding missing
 	 * observations (used after a loop closure to join both sides of the loop). Returns the
@@ -75,6 +113,9 @@ class LocalMapper
 	int fuseLandmarks(KeyFrameId target, const std::vector<LandmarkId>& lms, const PinholeIntrinsics& K);
 
    private:
+	/** Up to the bundle adjustment: probation and culling of new landmarks, then, when the map
+	 * has another keyframe, triangulation, fusion and covisibility (pass.m_refined). */
+	void refine(LocalMappingPass& pass, const PinholeIntrinsics& K);
 	int cullRecentLandmarks(KeyFrameId current);
 	/** New landmarks from keypoints without one, matched with neighbour keyframes. */
 	int triangulateNew(KeyFrameId kf, const PinholeIntrinsics& K);

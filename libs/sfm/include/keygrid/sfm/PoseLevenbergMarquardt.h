@@ -32,10 +32,9 @@
 
 namespace keygrid::sfm
 {
-/** One observation of a fixed point, in the form the solver evaluates. */
-struct PoseResidualTerm
+/** What one keypoint measured, with its weights: the residual's constants (see above). */
+struct ReprojectionMeasurement
 {
-	Eigen::Vector3d p_world{Eigen::Vector3d::Zero()};
 	Eigen::Vector2d uv{Eigen::Vector2d::Zero()};  //!< undistorted pixel
 	double invSigma{1};                           //!< 1 / sigma_level on (u, v)
 	double disparity{0};                          //!< bf / d_obs; 0: no depth residual
@@ -43,7 +42,15 @@ struct PoseResidualTerm
 	double huberDelta{0};                         //!< Huber threshold on |r|; 0: plain least squares
 };
 
-struct PoseSolverOptions
+/** One observation of a fixed point, in the form the solver evaluates. */
+struct PoseResidualTerm : ReprojectionMeasurement
+{
+	Eigen::Vector3d p_world{Eigen::Vector3d::Zero()};
+};
+
+/** Stopping rules and the start of the trust region of the dedicated Levenberg-Marquardt
+ * solvers (this one and BundleLevenbergMarquardt.h), as Ceres' options of the same names. */
+struct LevenbergMarquardtOptions
 {
 	int maxIterations{10};
 	double functionTolerance{1e-6};
@@ -51,6 +58,7 @@ struct PoseSolverOptions
 	double parameterTolerance{1e-8};
 	double initialTrustRegionRadius{1e4};
 };
+using PoseSolverOptions = LevenbergMarquardtOptions;
 
 struct PoseSolverSummary
 {

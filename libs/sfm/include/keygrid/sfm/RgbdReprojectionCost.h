@@ -22,15 +22,16 @@
  * the pose free along the rotation/translation ambiguity of narrow-field reprojection.) The
  * caller adds the robust (Huber) loss.
  */
+#include <keygrid/core/PinholeIntrinsics.h>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
 namespace keygrid::sfm
 {
-struct PinholeIntrinsics
-{
-	double fx{525}, fy{525}, cx{319.5}, cy{239.5};
-};
+/** The undistorted image's pinhole model (core/PinholeIntrinsics.h: why it is apart from
+ * core::RgbdCamera); sfm::intrinsicsOf() converts a camera. */
+using PinholeIntrinsics = core::PinholeIntrinsics;
 
 /** Pixel (and virtual right pixel) of p_world seen from T_cam_world; returns false behind. */
 template <typename T>
@@ -183,21 +184,6 @@ struct AnalyticReprojectionCost
 	double m_disparity, m_bf, m_invSigma, m_invSigmaDisparity;
 	bool m_rgbd;
 	PinholeIntrinsics m_K;
-};
-
-/** Wraps a 3-parameter-block cost so that the point is a constant (pose-only problems). */
-template <typename Cost>
-struct FixedPointCost
-{
-	FixedPointCost(const Cost& c, const Eigen::Vector3d& p_world) : m_cost(c), m_p(p_world) {}
-	template <typename T>
-	bool operator()(const T* q, const T* t, T* r) const
-	{
-		const T p[3] = {T(m_p.x()), T(m_p.y()), T(m_p.z())};
-		return m_cost(q, t, p, r);
-	}
-	Cost m_cost;
-	Eigen::Vector3d m_p;
 };
 
 }  // namespace keygrid::sfm

@@ -128,8 +128,9 @@ class SparseMap
 	std::size_t numKeyFrames() const { return m_keyframes.size(); }
 	std::size_t numLandmarks() const { return m_landmarks.size(); }
 
-	/** The map's own lock, for threaded mode (tracking, mapping and loop closing on separate
-	 * threads; see slam::System). */
+	/** The one lock of map updates, for threaded mode (tracking, mapping and loop closing on
+	 * separate threads; see slam::System): whoever reads or writes the map while the others
+	 * run holds it. LocalMappingPass::solve() is the local mapping step that runs without it. */
 	std::mutex& mutex() const { return m_mutex; }
 	/** Counts corrections that moved the whole map (loop closures). A result computed from an
 	 * older state, e.g. a bundle adjustment solved without the lock, must not be written back

@@ -220,8 +220,9 @@ class Tracker
 	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
 };
 
-/** Back-projects an undistorted pixel with depth into the camera frame. */
-Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float depth);
-PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& cam);
+/** K.backProject(u, v, depth): an undistorted pixel with depth in the camera frame. */
+inline Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float depth) { return K.backProject(u, v, depth); }
+/** cam.pinhole() */
+inline PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& cam) { return cam.pinhole(); }
 
 }  // namespace keygrid::sfm

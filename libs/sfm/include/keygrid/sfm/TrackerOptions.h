@@ -2,6 +2,7 @@
 /** \file TrackerOptions.h
  * Parameters of frame tracking and keyframe selection.
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/maps/HocHistogram.h>
 #include <keygrid/sfm/Matcher.h>
 #include <keygrid/sfm/PnpSolver.h>
@@ -92,8 +93,12 @@ struct TrackerOptions
 	 * the application; see HocFrontend.h). */
 	maps::HocOptions hoc;
 
+	/** The [tracker] keys (without [hoc], which is a section of its own). */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "tracker") const;
 };
 
 /** Share of the local map in view that a relocalization must match: min(o.relocalizationMinInlierRatio,

@@ -5,8 +5,8 @@
  * re-anchoring?), and the re-estimation of frame poses against the refined map.
  */
 #include <keygrid/core/TumTrajectory.h>
+#include <keygrid/loop/LoopCloser.h>
 #include <keygrid/sfm/Tracker.h>
-#include <keygrid/slam/LoopCloser.h>
 #include <keygrid/slam/SlamConfig.h>
 
 #include <functional>
@@ -20,7 +20,7 @@ namespace keygrid::slam
 /** Seeds of the bounded final bundle adjustment (sfm::growBundleWindow): both ends of every
  * closed loop, the newest loop first (there the pose graph bent the trajectory and landmarks
  * were fused), then the newest keyframe (refined by the fewest local windows). */
-std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<LoopClosureEvent>& loops, const sfm::SparseMap& map);
+std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<loop::LoopClosureEvent>& loops, const sfm::SparseMap& map);
 
 struct FinalBundleAdjustment
 {
@@ -35,7 +35,7 @@ struct FinalBundleAdjustment
  * and Ceres' default tolerance (it runs once, to convergence); a landmark without a depth
  * measurement whose rays meet at less than mapping.minParallaxDeg stays out. */
 FinalBundleAdjustment finalBundleAdjustment(
-	sfm::SparseMap& map, const sfm::PinholeIntrinsics& K, const std::vector<LoopClosureEvent>& loops,
+	sfm::SparseMap& map, const sfm::PinholeIntrinsics& K, const std::vector<loop::LoopClosureEvent>& loops,
 	const RefinementOptions& rc, const sfm::LocalMapperOptions& mapping);
 
 /** Largest displacement [m], over the keyframes of `before` that are in `after`, of the camera

@@ -44,8 +44,12 @@ struct MapFeedOptions
 	 * "dense" (its depth image) (Default: sparse) */
 	std::string ism2dInput{"sparse"};
 
+	/** The [maps] keys. */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "maps") const;
 };
 
 /** The frontend's landmarks as a CHOCPointsMap (histograms as the frontend kept them). */

@@ -25,11 +25,15 @@
 #include <unordered_map>
 #include <vector>
 
-namespace keygrid::slam
+namespace keygrid::loop
 {
 class LoopCloser;
-class MetricMaps;
 struct LoopClosureEvent;
+}  // namespace keygrid::loop
+
+namespace keygrid::slam
+{
+class MetricMaps;
 
 /** INI section [store]: the session file of keygrid-slam --map / --load-map. */
 struct SessionRecorderOptions
@@ -53,9 +57,13 @@ struct SessionRecorderOptions
 	/** Compression of the keyframe images */
 	store::ImageCodecOptions codec;
 
+	/** The [store] keys, SQLite's and the image codec's included. */
+	core::OptionFields fields();
 	/** Throws std::invalid_argument naming the key when a value is invalid. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "store") const;
 };
 
 /** Counters for report.json. */
@@ -80,7 +88,7 @@ class SessionRecorder
 
 	/** After a keyframe went through local mapping and loop closing (map lock held): writes
 	 * what changed. `loop` may be null (no loop closing); `maps` may be null (no metric maps). */
-	void afterKeyFrame(const sfm::SparseMap& map, const LoopCloser* loop, const LoopClosureEvent* closed, const MetricMaps* maps);
+	void afterKeyFrame(const sfm::SparseMap& map, const loop::LoopCloser* loop, const loop::LoopClosureEvent* closed, const MetricMaps* maps);
 	/** Whether the next afterKeyFrame() with metric maps stores their snapshots. */
 	bool snapshotDueAtNextKeyFrame() const
 	{
@@ -88,7 +96,7 @@ class SessionRecorder
 	}
 	/** After the final refinement: the last changes and the map snapshots, then waits for the
 	 * writer and closes the file. Throws std::runtime_error naming the file on a write error. */
-	void finish(const sfm::SparseMap& map, const LoopCloser* loop, const MetricMaps* maps);
+	void finish(const sfm::SparseMap& map, const loop::LoopCloser* loop, const MetricMaps* maps);
 
 	/** Waits until every update so far is committed (throws like finish()). */
 	void flush()
@@ -118,15 +126,15 @@ class SessionRecorder
 		std::vector<sfm::KeyFrameId> observers;
 	};
 
-	void open(const sfm::SparseMap& map, const LoopCloser* loop);
+	void open(const sfm::SparseMap& map, const loop::LoopCloser* loop);
 	/** The changes since the last update (and records what is written now). withCounters:
 	 * also landmarks whose only change is in their visibility counters or HOC histogram. */
-	store::SessionWriteJob diff(const sfm::SparseMap& map, const LoopCloser* loop, bool withCounters);
+	store::SessionWriteJob diff(const sfm::SparseMap& map, const loop::LoopCloser* loop, bool withCounters);
 	/** Keyframes of diff(): new ones whole (with images), moved ones as poses, changed
 	 * covisibility as edges (weight 0: removed), erased ones by id. */
-	void diffKeyFrames(const sfm::SparseMap& map, const LoopCloser* loop, store::SessionWriteJob& job);
+	void diffKeyFrames(const sfm::SparseMap& map, const loop::LoopCloser* loop, store::SessionWriteJob& job);
 	/** A keyframe not written yet: its record (with its BoW vector), images and covisibility. */
-	void addNewKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, const LoopCloser* loop, store::SessionWriteJob& job);
+	void addNewKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, const loop::LoopCloser* loop, store::SessionWriteJob& job);
 	/** A keyframe written before: its pose and covisibility changes into `u` and `written`. */
 	void diffWrittenKeyFrame(sfm::KeyFrameId id, const sfm::KeyFrame& kf, WrittenKeyFrame& written, store::SessionUpdate& u);
 	/** Landmarks of diff(): written when any field changed, erased ones by id. Returns the

@@ -8,10 +8,10 @@
  * (the floor frame every map output is written in), [store] (the session file of --map) and [MappingApplication] (the maps themselves, MRPT's
  * CMultiMetricMap format, see MetricMaps). Keys absent from the file keep their documented defaults.
  */
+#include <keygrid/loop/LoopCloser.h>
 #include <keygrid/sfm/FeatureExtractor.h>
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/TrackerOptions.h>
-#include <keygrid/slam/LoopCloser.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SessionRecorder.h>
 
@@ -49,6 +49,13 @@ struct RefinementOptions
 	double mapReanchorMinShift{0.0};
 	/** Depth of that point [m]: about the range the maps are filled to (Default: 4 m) */
 	double mapReanchorDepth{4.0};
+
+	/** The [refinement] keys. */
+	core::OptionFields fields();
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "refinement") const;
 };
 
 /** How the stages of a run share the machine. */
@@ -93,9 +100,11 @@ struct SlamConfig
 	RefinementOptions refinement;
 	MapFeedOptions maps;
 	maps::FloorFrameOptions floor;
-	LoopClosingOptions loop;
+	loop::LoopClosingOptions loop;
 	SessionRecorderOptions store;
 
+	/** The [slam] keys (mode, camera, mapping_lag, busy_keyframe_ratio). */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;
 	/** Throws std::invalid_argument naming the first key of a SlamConfig section ([slam],

@@ -14,9 +14,9 @@
  * adjustment is solved, loop closing holds it per keyframe. finish() drains and joins.
  */
 #include <keygrid/core/TumTrajectory.h>
+#include <keygrid/loop/LoopCloser.h>
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/Tracker.h>
-#include <keygrid/slam/LoopCloser.h>
 #include <keygrid/slam/KeyFrameImageCache.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SessionLoader.h>
@@ -137,13 +137,13 @@ class System
 	/** A snapshot of the counters (several threads update them in threaded mode). */
 	SystemStats stats() const;
 	/** In threaded mode only after finish(). */
-	const std::vector<LoopClosureEvent>& loopClosures() const { return m_loops; }
+	const std::vector<loop::LoopClosureEvent>& loopClosures() const { return m_loops; }
 	/** Report of the final global bundle adjustment (finish()); empty when it did not run. */
 	const std::optional<sfm::BundleAdjusterReport>& globalBundleAdjustmentReport() const { return m_globalBa; }
 	/** Threaded mode: what stopped the mapping or loop-closing thread (empty if nothing did).
 	 * processExtracted() throws it; after finish() it is kept here. */
 	std::string backgroundError() const;
-	const LoopCloser* loopCloser() const { return m_loopCloser.get(); }
+	const loop::LoopCloser* loopCloser() const { return m_loopCloser.get(); }
 	StageTimings& timings() { return m_timings; }
 	const StageTimings& timings() const { return m_timings; }
 	const SlamConfig& config() const { return m_cfg; }
@@ -157,9 +157,14 @@ class System
 		double travelled{0};  //!< camera path length up to that frame [m]
 		sfm::PinholeIntrinsics K;
 	};
-	/** Local mapping of a new keyframe; the map lock is held (mapLock: released while the
-	 * bundle adjustment is solved). */
-	void mapKeyFrame(const KeyFrameJob& job, std::unique_lock<std::mutex>* mapLock);
+	/** Local mapping of a new keyframe in one go, map lock held (sequential mode). */
+	void mapKeyFrame(const KeyFrameJob& job);
+	/** Threaded mode: local mapping of a new keyframe, taking the map lock for the phases that
+	 * use the map and releasing it while the bundle adjustment is solved. False when the
+	 * keyframe was culled while it waited in the queue. */
+	bool mapKeyFrameConcurrently(const KeyFrameJob& job);
+	/** The counters and timings of one keyframe's local mapping. */
+	void recordLocalMapping(const sfm::LocalMappingReport& rep, double seconds);
 	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
 	 * tracker's last frame, which created the keyframe. */
 	void insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
@@ -205,7 +210,7 @@ class System
 	 * keyframes by themselves (trajectory()). Returns seconds per map stage. Map lock held. */
 	std::map<std::string, double> publishCorrection(const PoseCorrection& c, sfm::TrackedFrame* tf);
 	/** Loop detection and correction of a keyframe (map lock held); the event when one closed. */
-	std::optional<LoopClosureEvent> closeLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
+	std::optional<loop::LoopClosureEvent> closeLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
 	void mappingThread();
 	/** Threaded mode, tracking thread: blocks until local mapping is at most [slam]
 	 * mapping_lag keyframes behind (throws if a background thread failed). */
@@ -234,8 +239,8 @@ class System
 	std::size_t m_lostAtStart{0};
 	/** Keyframes of a map not merged yet, for the metric maps once it is. */
 	std::vector<KeyFrameJob> m_waitingForMerge;
-	std::unique_ptr<LoopCloser> m_loopCloser;
-	std::vector<LoopClosureEvent> m_loops;
+	std::unique_ptr<loop::LoopCloser> m_loopCloser;
+	std::vector<loop::LoopClosureEvent> m_loops;
 	std::optional<sfm::BundleAdjusterReport> m_globalBa;
 	double m_travelled{0};
 	std::optional<mrpt::poses::CPose3D> m_lastTrackedPose;

@@ -6,6 +6,8 @@
  */
 #include <keygrid/store/SessionRecords.h>
 
+#include <keygrid/core/OptionFields.h>
+
 #include <string>
 
 namespace mrpt::config
@@ -25,7 +27,10 @@ struct ImageCodecOptions
 	/** JPEG quality 1 .. 100 when colourFormat = jpg (Default: 95) */
 	int jpegQuality{95};
 
-	bool isValid(std::string* error = nullptr) const;
+	/** Its keys (in [store]). */
+	core::OptionFields fields();
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "store") const;
 	/** Keys colour_format, png_compression, jpeg_quality; invalid values throw naming the key. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;

@@ -2,6 +2,8 @@
 /** \file SessionStoreOptions.h
  * How a SessionStore talks to its SQLite file (INI section `[store]`).
  */
+#include <keygrid/core/OptionFields.h>
+
 #include <string>
 
 namespace mrpt::config
@@ -31,8 +33,10 @@ struct SessionStoreOptions
 	 * (Default: quick) */
 	std::string integrityCheck{"quick"};
 
-	/** Returns false and the offending key and value in *error when invalid. */
-	bool isValid(std::string* error = nullptr) const;
+	/** Its keys (in [store]). */
+	core::OptionFields fields();
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "store") const;
 	/** Keys durability, cache_size_kib, busy_timeout_ms, integrity_check; missing keys keep their value; an
 	 * invalid value throws std::invalid_argument naming the key. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);

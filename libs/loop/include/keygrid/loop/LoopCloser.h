@@ -20,7 +20,7 @@
 #include <set>
 #include <string>
 
-namespace keygrid::slam
+namespace keygrid::loop
 {
 struct LoopClosingOptions
 {
@@ -34,7 +34,7 @@ struct LoopClosingOptions
 	int trainKeyFrames{10};
 	/** Tree shape used for that training (Default: branching 10, 3 levels = 1000 words,
 	 * 10 k-means iterations, seed 1, one thread; trainingVocabularyDefaults()) */
-	loop::VocabularyOptions vocabularyOptions{trainingVocabularyDefaults()};
+	VocabularyOptions vocabularyOptions{trainingVocabularyDefaults()};
 	/** Candidates must be at least this many keyframes older than the query (Default: 15) */
 	int minKeyFrameGap{15};
 	/** Consecutive keyframes that must agree on a candidate group (Default: 3) */
@@ -42,7 +42,7 @@ struct LoopClosingOptions
 	/** Geometric verification: RANSAC on matched keypoints with depth (Default: inliers within
 	 * 0.04 m, 40 of them, at most 300 hypotheses, confidence 0.999, 5 refinement rounds, rigid,
 	 * seed 42; verificationRansacDefaults()) */
-	loop::RigidRansacOptions ransac{verificationRansacDefaults()};
+	RigidRansacOptions ransac{verificationRansacDefaults()};
 	/** Plausibility: the loop may move the current keyframe (relative to the loop keyframe) by
 	 * at most max_correction_base + max_correction_ratio x the path travelled between them
 	 * [m], and rotate it by at most max_correction_deg. Drift is a small fraction of the path;
@@ -58,17 +58,17 @@ struct LoopClosingOptions
 	double mergeMaxSeenThrough{0.01};
 	/** Covisibility edges of the pose graph need this many shared landmarks (Default: 100) */
 	int covisibilityEdgeMinWeight{100};
-	loop::PoseGraphOptions poseGraph;
+	PoseGraphOptions poseGraph;
 
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 
 	/** The default of vocabularyOptions: a tree small enough for the few keyframes that train
 	 * it in the run (train_keyframes). */
-	static loop::VocabularyOptions trainingVocabularyDefaults();
+	static VocabularyOptions trainingVocabularyDefaults();
 	/** The default of ransac: stricter than RigidRansacOptions' (more inliers, a tighter
 	 * distance), as a wrong loop bends the whole map. */
-	static loop::RigidRansacOptions verificationRansacDefaults();
+	static RigidRansacOptions verificationRansacDefaults();
 };
 
 /** One closed loop, with the pose change of every keyframe (for the maps). */
@@ -157,25 +157,25 @@ class LoopCloser
 	const std::string& vocabularyFile() const { return m_vocabFile; }
 	/** Replaces the vocabulary (a loaded session's, trained in its run and stored in the file);
 	 * `source` names it in reports. Clears the keyframe database. */
-	void useVocabulary(loop::Vocabulary vocabulary, const std::string& source);
+	void useVocabulary(Vocabulary vocabulary, const std::string& source);
 	/** Adds every keyframe of the map that is not in the keyframe database yet (a map loaded
 	 * from a session), its BoW vector computed from its descriptors. No-op without vocabulary. */
 	void indexKeyFrames();
 	/** The BoW vector of a keyframe in the database; nullptr when it is not there. */
-	const loop::BowVector* bowOf(sfm::KeyFrameId kf) const { return m_db.contains(kf) ? &m_db.bow(kf) : nullptr; }
-	const loop::Vocabulary& vocabulary() const { return m_vocab; }
+	const BowVector* bowOf(sfm::KeyFrameId kf) const { return m_db.contains(kf) ? &m_db.bow(kf) : nullptr; }
+	const Vocabulary& vocabulary() const { return m_vocab; }
 	/** One record per keyframe handled by process(), in order. */
 	const std::vector<LoopQueryRecord>& queries() const { return m_queries; }
 	/** Loops that passed verification but were rejected as implausible (the queries with
 	 * outcome Implausible; diagnostics). */
 	int rejectedImplausible() const;
 	/** The keyframe pose graph of the last correction (for posegraph.g2o). */
-	const std::optional<loop::PoseGraph>& lastPoseGraph() const { return m_lastGraph; }
+	const std::optional<PoseGraph>& lastPoseGraph() const { return m_lastGraph; }
 
    private:
 	void trainIfReady();
 	/** The consistent candidate, if any; fills rec's candidate fields. */
-	std::optional<sfm::KeyFrameId> detect(sfm::KeyFrameId kf, const loop::BowVector& bow, double& score, LoopQueryRecord& rec);
+	std::optional<sfm::KeyFrameId> detect(sfm::KeyFrameId kf, const BowVector& bow, double& score, LoopQueryRecord& rec);
 	/** True for a loop inside one map; for one between two maps (a merge), true once
 	 * mergeConsistency verified loops in a row agree on where the current map lies (else
 	 * rec.outcome = MergePending). */
@@ -194,13 +194,13 @@ class LoopCloser
 	sfm::LocalMapper& m_mapper;
 	LoopClosingOptions m_opts;
 	sfm::MatcherOptions m_matcher;
-	loop::Vocabulary m_vocab;
+	Vocabulary m_vocab;
 	std::string m_vocabFile;  //!< empty: trained in the run or loaded with a session
 	std::string m_vocabSource;  //!< useVocabulary()'s source, for reports
-	loop::KeyFrameDatabase m_db;
+	KeyFrameDatabase m_db;
 	std::set<sfm::KeyFrameId> m_dbIds;
-	loop::ConsistencyChecker m_consistency;
-	std::optional<loop::PoseGraph> m_lastGraph;
+	ConsistencyChecker m_consistency;
+	std::optional<PoseGraph> m_lastGraph;
 	/** Verified loops between two maps so far, agreeing on align = T_loopMap_currentMap. */
 	struct MergeHypothesis
 	{
@@ -218,4 +218,4 @@ class LoopCloser
 Eigen::Isometry3d toIsometry(const mrpt::poses::CPose3D& p);
 mrpt::poses::CPose3D toCPose3D(const Eigen::Isometry3d& T);
 
-}  // namespace keygrid::slam
+}  // namespace keygrid::loop

@@ -1,4 +1,4 @@
-#include <keygrid/slam/DataFiles.h>
+#include <keygrid/loop/DataFiles.h>
 #include <mrpt/system/filesystem.h>
 
 #include <cstdlib>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <system_error>
 
-namespace keygrid::slam
+namespace keygrid::loop
 {
 namespace
 {
@@ -43,4 +43,4 @@ std::string findDataFile(const std::string& relative)
 	throw std::runtime_error("data file '" + relative + "' not found in " + searched + " (set KEYGRID_SHARE_DIR to the folder holding it)");
 }
 
-}  // namespace keygrid::slam
+}  // namespace keygrid::loop

@@ -1,10 +1,18 @@
-#include <keygrid/slam/SeenThroughCheck.h>
+#include <keygrid/loop/SeenThroughCheck.h>
 
 #include <cmath>
 #include <set>
 
-namespace keygrid::slam
+namespace keygrid::loop
 {
+namespace
+{
+/** Landmarks at most this far in front of the target camera [m], or behind it, are not
+ * compared: closer than any depth camera measures, and near the camera plane the projection
+ * is ill-conditioned. */
+constexpr double kMinLandmarkDepth = 0.1;
+}  // namespace
+
 SeenThroughCount countSeenThrough(
 	const sfm::SparseMap& map, const std::vector<sfm::KeyFrameId>& sources, const Eigen::Isometry3d& T_target_points,
 	const sfm::KeyFrame& target, const sfm::PinholeIntrinsics& K, float radiusPx, double relTolerance, double absTolerance)
@@ -20,7 +28,7 @@ SeenThroughCount countSeenThrough(
 	for (const auto l : landmarks)
 	{
 		const Eigen::Vector3d p = T_target_points * map.landmark(l).p_world;
-		if (p.z() <= 0.1) continue;
+		if (p.z() <= kMinLandmarkDepth) continue;
 		const double u = K.fx * p.x() / p.z() + K.cx, v = K.fy * p.y() / p.z() + K.cy;
 		if (u < 0 || v < 0 || u >= f.camera.width || v >= f.camera.height) continue;
 		f.featuresInArea(static_cast<float>(u), static_cast<float>(v), radiusPx, -1, -1, near);
@@ -42,4 +50,4 @@ SeenThroughCount countSeenThrough(
 	return out;
 }
 
-}  // namespace keygrid::slam
+}  // namespace keygrid::loop

@@ -4,7 +4,7 @@
  * front of it (seen through), moved into the target's frame by a known transform.
  */
 #include <gtest/gtest.h>
-#include <keygrid/slam/SeenThroughCheck.h>
+#include <keygrid/loop/SeenThroughCheck.h>
 
 #include <cmath>
 
@@ -58,7 +58,7 @@ TEST(SeenThroughCheck, CountsLandmarksOnBehindAndInFrontOfTheMeasuredSurface)
 	for (int k = 0; k < 12; k++, i += 7) map.addLandmark(at(i, 1.5), srcId, i);
 	for (int k = 0; k < 7; k++, i += 7) map.addLandmark(at(i, 4.5), srcId, i);
 
-	const auto c = slam::countSeenThrough(map, {srcId}, T_target_points, wallKeyFrame(), K);
+	const auto c = loop::countSeenThrough(map, {srcId}, T_target_points, wallKeyFrame(), K);
 	EXPECT_EQ(c.agreeing, 30);
 	EXPECT_EQ(c.seenThrough, 12);
 	EXPECT_DOUBLE_EQ(c.ratio(), 12.0 / 42.0);
@@ -67,7 +67,7 @@ TEST(SeenThroughCheck, CountsLandmarksOnBehindAndInFrontOfTheMeasuredSurface)
 	// every one of them outside the target's view.
 	Eigen::Isometry3d away = T_target_points;
 	away.translation().x() += 10.0;
-	const auto none = slam::countSeenThrough(map, {srcId}, away, wallKeyFrame(), K);
+	const auto none = loop::countSeenThrough(map, {srcId}, away, wallKeyFrame(), K);
 	EXPECT_EQ(none.agreeing + none.seenThrough, 0);
 	EXPECT_EQ(none.ratio(), 0.0);
 }

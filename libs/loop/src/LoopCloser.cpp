@@ -1,7 +1,7 @@
 #include <keygrid/sfm/Tracker.h>
-#include <keygrid/slam/DataFiles.h>
-#include <keygrid/slam/LoopCloser.h>
-#include <keygrid/slam/SeenThroughCheck.h>
+#include <keygrid/loop/DataFiles.h>
+#include <keygrid/loop/LoopCloser.h>
+#include <keygrid/loop/SeenThroughCheck.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/CMatrixFixed.h>
 
@@ -9,8 +9,30 @@
 #include <chrono>
 #include <set>
 
-namespace keygrid::slam
+namespace keygrid::loop
 {
+namespace
+{
+/** More covisible keyframes than any keyframe has: the reference score of a query is taken
+ * over all of them. */
+constexpr std::size_t kAllCovisibles = 1000;
+/** Database candidates a query returns, best first. */
+constexpr std::size_t kMaxCandidates = 10;
+/** A candidate must score at least as high as the least similar covisible keyframe (ORB-SLAM's
+ * normalisation): places look alike at different rates. */
+constexpr double kMinScoreToReference = 1.0;
+/** A candidate's group for the consistency check: it and this many of its best covisibles. */
+constexpr std::size_t kCandidateGroupNeighbours = 10;
+/** Ratio test of the verification matches: the best descriptor distance must be clearly
+ * smaller than the second best, as repeated texture gives ambiguous matches. */
+constexpr float kVerificationMatchRatio = 0.8f;
+/** Each side of a loop (seen-through test, landmark fusion): the keyframe and this many of its
+ * best covisibles. */
+constexpr std::size_t kLoopSideNeighbours = 5;
+/** Keyframes after a closed loop without detection: the map around it is still being joined. */
+constexpr sfm::KeyFrameId kKeyFramesPausedAfterLoop = 5;
+}  // namespace
+
 Eigen::Isometry3d toIsometry(const mrpt::poses::CPose3D& p)
 {
 	Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
@@ -67,9 +89,9 @@ const char* toString(LoopQueryOutcome o)
 	return "?";
 }
 
-loop::VocabularyOptions LoopClosingOptions::trainingVocabularyDefaults()
+VocabularyOptions LoopClosingOptions::trainingVocabularyDefaults()
 {
-	loop::VocabularyOptions o;
+	VocabularyOptions o;
 	o.branching = 10;
 	o.levels = 3;
 	o.maxIterations = 10;
@@ -78,9 +100,9 @@ loop::VocabularyOptions LoopClosingOptions::trainingVocabularyDefaults()
 	return o;
 }
 
-loop::RigidRansacOptions LoopClosingOptions::verificationRansacDefaults()
+RigidRansacOptions LoopClosingOptions::verificationRansacDefaults()
 {
-	loop::RigidRansacOptions o;
+	RigidRansacOptions o;
 	o.inlierThreshold = 0.04;
 	o.minInliers = 40;
 	o.maxIterations = 300;
@@ -155,8 +177,8 @@ LoopCloser::LoopCloser(
 	// SIFT runs train their own in the run.
 	if (opts.vocabulary == "train" || (opts.vocabulary == "default" && featureType != "orb")) return;
 	m_vocabFile = opts.vocabulary == "default" ? findDataFile("vocabulary/keygrid_orb_k10_L4.bin") : opts.vocabulary;
-	m_vocab = loop::Vocabulary::load(m_vocabFile);
-	const bool binary = m_vocab.descriptorType() == loop::DescriptorType::Binary;
+	m_vocab = Vocabulary::load(m_vocabFile);
+	const bool binary = m_vocab.descriptorType() == DescriptorType::Binary;
 	if (binary != (featureType == "orb"))
 		throw std::invalid_argument(
 			"vocabulary '" + m_vocabFile + "' holds " + (binary ? "binary (ORB)" : "float (SIFT)") + " descriptors, but [features] type = " + featureType);
@@ -175,7 +197,7 @@ void LoopCloser::trainIfReady()
 	if (!m_vocab.empty() || static_cast<int>(m_map.numKeyFrames()) < m_opts.trainKeyFrames) return;
 	std::vector<cv::Mat> descs;
 	for (const auto& [id, kf] : m_map.keyframes()) descs.push_back(kf.features.descriptors);
-	m_vocab = loop::Vocabulary::train(descs, m_opts.vocabularyOptions);
+	m_vocab = Vocabulary::train(descs, m_opts.vocabularyOptions);
 	for (const auto& [id, kf] : m_map.keyframes())
 	{
 		m_db.add(id, m_vocab.transform(kf.features.descriptors));
@@ -183,7 +205,7 @@ void LoopCloser::trainIfReady()
 	}
 }
 
-void LoopCloser::useVocabulary(loop::Vocabulary vocabulary, const std::string& source)
+void LoopCloser::useVocabulary(Vocabulary vocabulary, const std::string& source)
 {
 	m_vocab = std::move(vocabulary);
 	m_vocabFile.clear();
@@ -207,7 +229,7 @@ std::vector<sfm::KeyFrameId> LoopCloser::placeCandidates(const cv::Mat& descript
 {
 	std::vector<sfm::KeyFrameId> out;
 	if (m_vocab.empty() || maxCandidates <= 0 || descriptors.empty()) return out;
-	loop::DatabaseQuery q;
+	DatabaseQuery q;
 	q.maxResults = static_cast<std::size_t>(maxCandidates);
 	for (const auto& c : m_db.query(m_vocab.transform(descriptors), q))
 		if (m_map.hasKeyFrame(c.id)) out.push_back(c.id);
@@ -220,19 +242,19 @@ int LoopCloser::rejectedImplausible() const
 		m_queries.begin(), m_queries.end(), [](const LoopQueryRecord& q) { return q.outcome == LoopQueryOutcome::Implausible; }));
 }
 
-std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const loop::BowVector& bow, double& score, LoopQueryRecord& rec)
+std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const BowVector& bow, double& score, LoopQueryRecord& rec)
 {
 	const auto t0 = std::chrono::steady_clock::now();
 	// Reference: the lowest similarity with the covisible keyframes (ORB-SLAM's normalisation).
-	const auto covis = m_map.bestCovisibles(kfId, 1000);
+	const auto covis = m_map.bestCovisibles(kfId, kAllCovisibles);
 	double ref = 1.0;
 	for (auto c : covis)
 		if (m_db.contains(c)) ref = std::min(ref, m_vocab.score(bow, m_db.bow(c)));
 	if (covis.empty()) ref = 0.0;
-	loop::DatabaseQuery q;
-	q.maxResults = 10;
+	DatabaseQuery q;
+	q.maxResults = kMaxCandidates;
 	q.referenceScore = ref;
-	q.minRatioToReference = 1.0;
+	q.minRatioToReference = kMinScoreToReference;
 	q.exclude.insert(kfId);
 	for (auto c : covis) q.exclude.insert(c);
 	for (const auto& [id, kf] : m_map.keyframes())
@@ -246,14 +268,14 @@ std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const lo
 		rec.bestCandidate = cands.front().id;
 		rec.bestScore = cands.front().score;
 	}
-	std::vector<loop::CandidateGroup> groups;
+	std::vector<CandidateGroup> groups;
 	for (const auto& c : cands)
 	{
 		if (!m_map.hasKeyFrame(c.id)) continue;
-		loop::CandidateGroup g;
+		CandidateGroup g;
 		g.candidate = c.id;
 		g.group.insert(c.id);
-		for (auto n : m_map.bestCovisibles(c.id, 10)) g.group.insert(n);
+		for (auto n : m_map.bestCovisibles(c.id, kCandidateGroupNeighbours)) g.group.insert(n);
 		groups.push_back(g);
 	}
 	const auto consistent = m_consistency.check(groups);
@@ -271,7 +293,7 @@ bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::Pi
 	const auto& a = m_map.keyframe(cand);
 	const auto& b = m_map.keyframe(cur);
 	std::vector<Eigen::Vector3d> pa, pb;
-	for (const auto& [i, j] : sfm::matchBruteForce(a.features, b.features, m_matcher, 0.8f))
+	for (const auto& [i, j] : sfm::matchBruteForce(a.features, b.features, m_matcher, kVerificationMatchRatio))
 	{
 		const float da = a.features.depth[i], db = b.features.depth[j];
 		if (da <= 0 || db <= 0) continue;
@@ -284,7 +306,7 @@ bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::Pi
 		rec.outcome = LoopQueryOutcome::FewMatches;
 		return false;
 	}
-	const auto r = loop::estimateRigidTransformRansac(pa, pb, m_opts.ransac);
+	const auto r = estimateRigidTransformRansac(pa, pb, m_opts.ransac);
 	rec.inliers = r.numInliers;
 	if (!r.success)
 	{
@@ -309,8 +331,8 @@ bool LoopCloser::mergeConfirmed(
 	const Eigen::Isometry3d align = toIsometry(l.T_world_cam) * T_cand_cur * toIsometry(c.T_world_cam).inverse();
 	// Free space: neither keyframe may see through the other side's landmarks.
 	std::vector<sfm::KeyFrameId> loopSide = {cand}, curSide = {cur};
-	for (const auto n : m_map.bestCovisibles(cand, 5)) loopSide.push_back(n);
-	for (const auto n : m_map.bestCovisibles(cur, 5)) curSide.push_back(n);
+	for (const auto n : m_map.bestCovisibles(cand, kLoopSideNeighbours)) loopSide.push_back(n);
+	for (const auto n : m_map.bestCovisibles(cur, kLoopSideNeighbours)) curSide.push_back(n);
 	auto seen = countSeenThrough(m_map, loopSide, (toIsometry(l.T_world_cam) * T_cand_cur).inverse(), c, K);
 	seen += countSeenThrough(m_map, curSide, toIsometry(l.T_world_cam).inverse() * align, l, K);
 	rec.seenThroughRatio = seen.ratio();
@@ -377,13 +399,13 @@ KeyFramePoses keyFramePoses(const sfm::SparseMap& map)
  * keyframes of the current map moved first by `align`; odometry edges between consecutive
  * keyframes of one map and covisibility edges between strongly covisible ones, all keeping
  * their current relative poses; the loop edge with its measurement; the gauge fixed. */
-loop::PoseGraph loopCorrectionGraph(
+PoseGraph loopCorrectionGraph(
 	const sfm::SparseMap& map, const KeyFramePoses& oldIso, sfm::KeyFrameId cur, sfm::KeyFrameId cand,
 	const Eigen::Isometry3d& T_cand_cur, const Eigen::Isometry3d& align, int covisibilityEdgeMinWeight)
 {
 	const std::uint32_t curMap = map.keyframe(cur).mapId;
 	const bool merge = curMap != map.keyframe(cand).mapId;
-	loop::PoseGraph g;
+	PoseGraph g;
 	for (const auto& [id, kf] : map.keyframes()) g.addVertex(id, kf.mapId == curMap ? align * oldIso.at(id) : oldIso.at(id));
 	auto rel = [&](sfm::KeyFrameId a, sfm::KeyFrameId b) { return g.pose(a).inverse() * g.pose(b); };
 	std::map<std::uint32_t, sfm::KeyFrameId> prevOfMap;
@@ -392,13 +414,13 @@ loop::PoseGraph loopCorrectionGraph(
 		const auto p = prevOfMap.find(kf.mapId);
 		const bool hasPrev = p != prevOfMap.end();
 		const sfm::KeyFrameId prev = hasPrev ? p->second : 0;
-		if (hasPrev) g.addEdge({prev, id, rel(prev, id), loop::Matrix6d::Identity(), loop::EdgeKind::Odometry});
+		if (hasPrev) g.addEdge({prev, id, rel(prev, id), Matrix6d::Identity(), EdgeKind::Odometry});
 		for (const auto& [other, w] : kf.covisibility)
 			if (other < id && w >= covisibilityEdgeMinWeight && (!hasPrev || other != prev))
-				g.addEdge({other, id, rel(other, id), loop::Matrix6d::Identity(), loop::EdgeKind::Covisibility});
+				g.addEdge({other, id, rel(other, id), Matrix6d::Identity(), EdgeKind::Covisibility});
 		prevOfMap[kf.mapId] = id;
 	}
-	g.addEdge({cand, cur, T_cand_cur, loop::Matrix6d::Identity(), loop::EdgeKind::Loop});
+	g.addEdge({cand, cur, T_cand_cur, Matrix6d::Identity(), EdgeKind::Loop});
 	// Gauge: the first keyframe defines the world frame; the loop only bends the rest onto
 	// it. A loop inside a map not merged yet keeps that map's first keyframe in place.
 	g.setFixed(map.keyframes().begin()->first);
@@ -422,7 +444,7 @@ void moveLandmarksWithKeyFrames(sfm::SparseMap& map, const KeyFramePoses& oldIso
 		sfm::KeyFrameId ref = lm.firstKeyFrame;
 		if (!newIso.count(ref)) ref = lm.observations.begin()->first;
 		if (!newIso.count(ref)) continue;
-		moved.emplace_back(id, loop::movePointWithKeyFrame(lm.p_world, oldIso.at(ref), newIso.at(ref)));
+		moved.emplace_back(id, movePointWithKeyFrame(lm.p_world, oldIso.at(ref), newIso.at(ref)));
 	}
 	for (const auto& [id, p] : moved) map.landmark(id).p_world = p;
 }
@@ -433,8 +455,8 @@ void joinLoopSides(sfm::SparseMap& map, sfm::LocalMapper& mapper, sfm::KeyFrameI
 {
 	std::set<sfm::LandmarkId> loopSide;
 	std::vector<sfm::KeyFrameId> loopGroup = {cand}, curGroup = {cur};
-	for (auto n : map.bestCovisibles(cand, 5)) loopGroup.push_back(n);
-	for (auto n : map.bestCovisibles(cur, 5)) curGroup.push_back(n);
+	for (auto n : map.bestCovisibles(cand, kLoopSideNeighbours)) loopGroup.push_back(n);
+	for (auto n : map.bestCovisibles(cur, kLoopSideNeighbours)) curGroup.push_back(n);
 	for (auto id : loopGroup)
 		for (auto l : map.keyframe(id).landmarks)
 			if (l != sfm::kNoLandmark) loopSide.insert(l);
@@ -460,7 +482,7 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 	const Eigen::Isometry3d align = merge ? toIsometry(m_map.keyframe(cand).T_world_cam) * T_cand_cur * toIsometry(m_map.keyframe(cur).T_world_cam).inverse()
 										  : Eigen::Isometry3d::Identity();
 	KeyFramePoses oldIso = keyFramePoses(m_map), newIso;
-	loop::PoseGraph g = loopCorrectionGraph(m_map, oldIso, cur, cand, T_cand_cur, align, m_opts.covisibilityEdgeMinWeight);
+	PoseGraph g = loopCorrectionGraph(m_map, oldIso, cur, cand, T_cand_cur, align, m_opts.covisibilityEdgeMinWeight);
 	const auto summary = g.optimize(m_opts.poseGraph);
 
 	LoopClosureEvent ev;
@@ -535,12 +557,11 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 		return std::nullopt;
 	}
 	const auto t0 = std::chrono::steady_clock::now();
-	const loop::BowVector bow = m_vocab.transform(m_map.keyframe(kf).features.descriptors);
+	const BowVector bow = m_vocab.transform(m_map.keyframe(kf).features.descriptors);
 	rec.querySeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	double score = 0;
 	std::optional<LoopClosureEvent> out;
-	// No detection right after a loop: the map around it is still being joined.
-	if (m_anyLoop && kf <= m_lastLoopKf + 5)
+	if (m_anyLoop && kf <= m_lastLoopKf + kKeyFramesPausedAfterLoop)
 		rec.outcome = LoopQueryOutcome::AfterLoop;
 	else if (auto cand = detect(kf, bow, score, rec); !cand)
 		rec.outcome = rec.candidates ? LoopQueryOutcome::NotConsistent : LoopQueryOutcome::NoCandidate;
@@ -558,4 +579,4 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 	return out;
 }
 
-}  // namespace keygrid::slam
+}  // namespace keygrid::loop

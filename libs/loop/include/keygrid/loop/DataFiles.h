@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace keygrid::slam
+namespace keygrid::loop
 {
 /** Folders searched, in order: $KEYGRID_SHARE_DIR (when set), share/keygrid beside the running
  * executable's folder (an installed tool, in whatever prefix), the source tree's share/, the
@@ -17,4 +17,4 @@ std::vector<std::string> dataDirectories();
  * dataDirectories() holding it; throws std::runtime_error naming every folder searched. */
 std::string findDataFile(const std::string& relative);
 
-}  // namespace keygrid::slam
+}  // namespace keygrid::loop

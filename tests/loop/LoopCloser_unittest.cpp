@@ -6,7 +6,7 @@
 // within a bound derived from the noise, and the correction must take the map most of the way
 // to the measurement. On a path that stops short of its start no loop may be claimed.
 #include <keygrid/sfm/Tracker.h>
-#include <keygrid/slam/LoopCloser.h>
+#include <keygrid/loop/LoopCloser.h>
 
 #include "SyntheticFeatures.h"
 #include "TestData.h"
@@ -36,18 +36,7 @@ constexpr double kMaxDepth = kWallRadius + kPathRadius;
  * observes it; a point seen again after that gets a new landmark, as tracking would create one. */
 constexpr sfm::KeyFrameId kLocalMapKeyFrames = 5;
 
-test::SyntheticPoints makeWall(std::mt19937& rng)
-{
-	test::SyntheticPoints w;
-	std::uniform_real_distribution<double> azimuth(0, 2 * M_PI), height(-kWallHalfHeight, kWallHalfHeight);
-	for (int i = 0; i < kWallPoints; i++)
-	{
-		const double a = azimuth(rng);
-		w.p_world.emplace_back(kWallRadius * std::sin(a), height(rng), kWallRadius * std::cos(a));
-	}
-	w.descriptors = test::randomDescriptors(kWallPoints, rng);
-	return w;
-}
+test::SyntheticPoints makeWall(std::mt19937& rng) { return test::cylinderWall(rng, kWallRadius, kWallHalfHeight, kWallPoints); }
 
 double headingDeg(std::size_t k) { return kHeadingStepDeg * static_cast<double>(k); }
 
@@ -102,11 +91,11 @@ class LoopRun
 	 * first keyframe in the map just before and just after the correction. */
 	struct Closure
 	{
-		slam::LoopClosureEvent event;
+		loop::LoopClosureEvent event;
 		CPose3D T_loop_cur_before, T_loop_cur_after, T_first_cur_before, T_first_cur_after;
 	};
 
-	const slam::LoopCloser& loopCloser() const { return m_loop; }
+	const loop::LoopCloser& loopCloser() const { return m_loop; }
 	const std::vector<Closure>& closures() const { return m_closures; }
 	const test::MeasurementNoise& noise() const { return m_noise; }
 
@@ -127,9 +116,9 @@ class LoopRun
 	}
 
    private:
-	static slam::LoopClosingOptions options()
+	static loop::LoopClosingOptions options()
 	{
-		slam::LoopClosingOptions o;
+		loop::LoopClosingOptions o;
 		o.vocabulary = "train";  // on the first keyframes: no file needed
 		return o;
 	}
@@ -166,7 +155,7 @@ class LoopRun
 	test::SyntheticPoints m_wall;
 	sfm::SparseMap m_map;
 	sfm::LocalMapper m_mapper;
-	slam::LoopCloser m_loop;
+	loop::LoopCloser m_loop;
 	/** wall point -> (its landmark, the last keyframe observing it) */
 	std::map<int, std::pair<sfm::LandmarkId, sfm::KeyFrameId>> m_landmarkOfPoint;
 	std::map<sfm::KeyFrameId, std::vector<int>> m_pointsOf;  //!< the wall points each keyframe sees
@@ -180,7 +169,7 @@ TEST(LoopCloser, ClosesTheLoopBetweenKeyFramesOfTheSamePlaceWithTheGroundTruthPo
 	LoopRun run(1);
 	for (std::size_t k = 0; k < kKeyFramesWithLoop; k++) run.addKeyFrame(k);
 	ASSERT_FALSE(run.closures().empty());
-	const int minInliers = slam::LoopClosingOptions().ransac.minInliers;
+	const int minInliers = loop::LoopClosingOptions().ransac.minInliers;
 	const double pointSigma = std::sqrt(2.0) * run.noise().pointSigma(kMaxDepth, core::RgbdCamera().fx);
 	for (const auto& c : run.closures())
 	{
@@ -188,9 +177,9 @@ TEST(LoopCloser, ClosesTheLoopBetweenKeyFramesOfTheSamePlaceWithTheGroundTruthPo
 		SCOPED_TRACE("loop " + std::to_string(ev.keyframe) + " -> " + std::to_string(ev.loopKeyFrame));
 		// The right pair: the loop keyframe is an old one that sees enough of the current one's
 		// wall to be verified, and at least half as much as the old keyframe that sees most of it.
-		EXPECT_GE(ev.keyframe, ev.loopKeyFrame + static_cast<sfm::KeyFrameId>(slam::LoopClosingOptions().minKeyFrameGap));
+		EXPECT_GE(ev.keyframe, ev.loopKeyFrame + static_cast<sfm::KeyFrameId>(loop::LoopClosingOptions().minKeyFrameGap));
 		std::size_t mostShared = 0;
-		for (sfm::KeyFrameId old = 0; old + static_cast<sfm::KeyFrameId>(slam::LoopClosingOptions().minKeyFrameGap) <= ev.keyframe; old++)
+		for (sfm::KeyFrameId old = 0; old + static_cast<sfm::KeyFrameId>(loop::LoopClosingOptions().minKeyFrameGap) <= ev.keyframe; old++)
 			mostShared = std::max(mostShared, run.sharedPoints_cam(old, ev.keyframe).size());
 		const auto shared = run.sharedPoints_cam(ev.loopKeyFrame, ev.keyframe);
 		EXPECT_GE(shared.size(), static_cast<std::size_t>(minInliers));
@@ -232,10 +221,10 @@ TEST(LoopCloser, ClaimsNoLoopOnAPathWithoutRevisit)
 	int queried = 0;
 	for (const auto& q : run.loopCloser().queries())
 	{
-		EXPECT_NE(q.outcome, slam::LoopQueryOutcome::Closed) << "keyframe " << q.keyframe;
-		queried += q.outcome != slam::LoopQueryOutcome::NoVocabulary;
+		EXPECT_NE(q.outcome, loop::LoopQueryOutcome::Closed) << "keyframe " << q.keyframe;
+		queried += q.outcome != loop::LoopQueryOutcome::NoVocabulary;
 	}
 	// The keyframe that completes the training set trains the vocabulary and is not queried.
-	EXPECT_EQ(queried, kKeyFramesWithoutLoop - slam::LoopClosingOptions().trainKeyFrames);
+	EXPECT_EQ(queried, kKeyFramesWithoutLoop - loop::LoopClosingOptions().trainKeyFrames);
 	EXPECT_FALSE(run.loopCloser().lastPoseGraph().has_value());
 }

@@ -15,7 +15,7 @@
 #include <Eigen/Geometry>
 #include <vector>
 
-namespace keygrid::slam
+namespace keygrid::loop
 {
 struct SeenThroughCount
 {
@@ -40,4 +40,4 @@ SeenThroughCount countSeenThrough(
 	const sfm::KeyFrame& target, const sfm::PinholeIntrinsics& K, float radiusPx = 4.f, double relTolerance = 0.1,
 	double absTolerance = 0.05);
 
-}  // namespace keygrid::slam
+}  // namespace keygrid::loop

@@ -1,0 +1,252 @@
+// TwoViewInitializer: options, model selection and the choice among motion hypotheses
+// (Mur-Artal et al. 2015, section IV). Model fits: _models.cpp; hypothesis checks:
+// _reconstruct.cpp.
+#include <keygrid/core/ConfigReading.h>
+#include <keygrid/sfm/TwoViewInitializer.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <future>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+
+#include "TwoViewInitializerDetail.h"
+
+namespace keygrid::sfm
+{
+void TwoViewOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	ransacIterations = static_cast<int>(core::readInteger(c, s, "ransac_iterations", ransacIterations, 1, 100000));
+	seed = static_cast<uint64_t>(core::readWholeNumber(c, s, "seed", static_cast<long long>(seed)));
+	sigmaPx = core::readFiniteNumber(c, s, "sigma_px", sigmaPx);
+	minMatches = static_cast<int>(core::readInteger(c, s, "min_matches", minMatches, 8, 1000000));
+	minParallaxDeg = core::readFiniteNumber(c, s, "min_parallax_deg", minParallaxDeg);
+	minPointParallaxDeg = core::readFiniteNumber(c, s, "min_point_parallax_deg", minPointParallaxDeg);
+	minTriangulated = static_cast<int>(core::readInteger(c, s, "min_triangulated", minTriangulated, 1, 1000000));
+	minGoodShare = core::readFiniteNumber(c, s, "min_good_share", minGoodShare);
+	maxSecondBestShare = core::readFiniteNumber(c, s, "max_second_best_share", maxSecondBestShare);
+	homographyRatio = core::readFiniteNumber(c, s, "homography_ratio", homographyRatio);
+	homographyInlierShare = core::readFiniteNumber(c, s, "homography_inlier_share", homographyInlierShare);
+	parallel = core::readBoolean(c, s, "parallel", parallel);
+	std::string err;
+	if (!isValid(&err)) throw std::invalid_argument("[" + s + "] " + err);
+}
+
+void TwoViewOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	c.write(s, "ransac_iterations", ransacIterations, 30, 40, "RANSAC draws shared by H and F");
+	c.write(s, "seed", std::to_string(seed), 30, 40, "RNG seed (reproducible runs)");
+	c.write(s, "sigma_px", sigmaPx, 30, 40, "keypoint std at level 0 [px]");
+	c.write(s, "min_matches", minMatches, 30, 40, "fewer correspondences are refused");
+	c.write(s, "min_parallax_deg", minParallaxDeg, 30, 40, "median parallax needed [deg]");
+	c.write(s, "min_point_parallax_deg", minPointParallaxDeg, 30, 40, "a map point needs this parallax [deg]");
+	c.write(s, "min_triangulated", minTriangulated, 30, 40, "map points needed");
+	c.write(s, "min_good_share", minGoodShare, 30, 40, "share of inliers the chosen motion must explain");
+	c.write(s, "max_second_best_share", maxSecondBestShare, 30, 40, "second-best / best good points above: ambiguous");
+	c.write(s, "homography_ratio", homographyRatio, 30, 40, "R_H = S_H / (S_H + S_F) above: homography");
+	c.write(s, "homography_inlier_share", homographyInlierShare, 30, 40, "H inliers / F inliers from which F is degenerate");
+	c.write(s, "parallel", parallel, 30, 40, "score H and F in parallel");
+}
+
+bool TwoViewOptions::isValid(std::string* error) const
+{
+	std::ostringstream e;
+	if (ransacIterations < 1) e << "ransac_iterations = " << ransacIterations << " (must be >= 1)";
+	else if (!(sigmaPx > 0)) e << "sigma_px = " << sigmaPx << " (must be > 0)";
+	else if (minMatches < 8) e << "min_matches = " << minMatches << " (must be >= 8: the 8-point needs 8)";
+	else if (!(minParallaxDeg >= 0 && minParallaxDeg < 90)) e << "min_parallax_deg = " << minParallaxDeg << " (must be in [0, 90))";
+	else if (!(minPointParallaxDeg >= 0 && minPointParallaxDeg < 90)) e << "min_point_parallax_deg = " << minPointParallaxDeg << " (must be in [0, 90))";
+	else if (minTriangulated < 1) e << "min_triangulated = " << minTriangulated << " (must be >= 1)";
+	else if (!(minGoodShare >= 0 && minGoodShare <= 1)) e << "min_good_share = " << minGoodShare << " (must be in [0, 1])";
+	else if (!(maxSecondBestShare > 0 && maxSecondBestShare <= 1)) e << "max_second_best_share = " << maxSecondBestShare << " (must be in (0, 1])";
+	else if (!(homographyRatio > 0 && homographyRatio < 1)) e << "homography_ratio = " << homographyRatio << " (must be in (0, 1))";
+	else if (!(homographyInlierShare > 0 && homographyInlierShare <= 1)) e << "homography_inlier_share = " << homographyInlierShare << " (must be in (0, 1])";
+	if (error) *error = e.str();
+	return e.str().empty();
+}
+
+const char* toString(TwoViewFailure f)
+{
+	switch (f)
+	{
+		case TwoViewFailure::None: return "none";
+		case TwoViewFailure::TooFewMatches: return "too few matches";
+		case TwoViewFailure::LowParallax: return "low parallax (pure rotation?)";
+		case TwoViewFailure::Ambiguous: return "ambiguous motion";
+		case TwoViewFailure::TooFewTriangulated: return "too few triangulated points";
+	}
+	return "?";
+}
+
+const char* toString(TwoViewModel m)
+{
+	switch (m)
+	{
+		case TwoViewModel::None: return "none";
+		case TwoViewModel::Homography: return "homography";
+		case TwoViewModel::Fundamental: return "fundamental";
+	}
+	return "?";
+}
+
+TwoViewInitializer::TwoViewInitializer(const PinholeIntrinsics& K, const TwoViewOptions& opts) : m_K(K), m_opts(opts)
+{
+	std::string err;
+	if (!opts.isValid(&err)) throw std::invalid_argument("TwoViewOptions: " + err);
+	if (!(K.fx > 0 && K.fy > 0)) throw std::invalid_argument("TwoViewInitializer: focal lengths must be > 0");
+}
+
+namespace
+{
+TwoViewResult fail(TwoViewResult r, TwoViewFailure f, const std::string& why)
+{
+	r.ok = false;
+	r.failure = f;
+	r.message = std::string(toString(f)) + ": " + why;
+	return r;
+}
+
+detail::WeightedMatches weigh(const TwoViewMatches& m, double sigmaPx)
+{
+	const std::size_t n = m.px_ref.size();
+	if (m.px_cur.size() != n || (!m.scale_ref.empty() && m.scale_ref.size() != n) || (!m.scale_cur.empty() && m.scale_cur.size() != n))
+		throw std::invalid_argument("TwoViewMatches: px_ref, px_cur and non-empty scale_ref/scale_cur must have one entry per correspondence");
+	detail::WeightedMatches w;
+	w.m = &m;
+	w.invVarRef.resize(n);
+	w.invVarCur.resize(n);
+	w.invVarPair.resize(n);
+	for (std::size_t i = 0; i < n; i++)
+	{
+		const double sr = sigmaPx * (m.scale_ref.empty() ? 1.0 : m.scale_ref[i]);
+		const double sc = sigmaPx * (m.scale_cur.empty() ? 1.0 : m.scale_cur[i]);
+		if (!(sr > 0 && sc > 0)) throw std::invalid_argument("TwoViewMatches: scales must be > 0");
+		w.invVarRef[i] = 1.0 / (sr * sr);
+		w.invVarCur[i] = 1.0 / (sc * sc);
+		w.invVarPair[i] = 1.0 / (sr * sr + sc * sc);
+	}
+	return w;
+}
+
+/** The motion hypotheses of the selected model; empty with a failure reason when it has none. */
+std::vector<RelativeMotion> hypotheses(const TwoViewResult& r, const PinholeIntrinsics& K, TwoViewFailure& why, std::string& text)
+{
+	Eigen::Matrix3d Km;
+	Km << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1;
+	if (r.model == TwoViewModel::Fundamental) return decomposeEssential(Km.transpose() * r.F_cur_ref * Km);
+	const Eigen::Matrix3d A = Km.inverse() * r.H_cur_ref * Km;
+	auto hs = decomposeHomography(A);
+	if (hs.empty())
+	{
+		// A = lambda (R + t n^T / d): equal singular values mean t n^T / d ~ 0 (rotation only)
+		// when all three coincide, a motion along the plane normal when two do.
+		const Eigen::Vector3d sv = A.jacobiSvd().singularValues();
+		const bool rotation = sv(0) / sv(2) < 1.0 + 1e-4;
+		why = rotation ? TwoViewFailure::LowParallax : TwoViewFailure::Ambiguous;
+		text = rotation ? "the homography is a rotation (no translation)" : "homography decomposition is not unique (two equal singular values)";
+	}
+	return hs;
+}
+
+/* The best hypothesis (most good points, refined) is accepted when, in this order of diagnosis:
+ * it triangulates at least min_triangulated points, its median parallax reaches
+ * min_parallax_deg (else: pure rotation or a too short baseline; checked before ambiguity
+ * because then t is unobservable and its hypotheses tie), no other hypothesis comes close
+ * (second / best <= max_second_best_share, both before refinement), it explains
+ * min_good_share of the inliers and has min_triangulated valid points. */
+TwoViewResult chooseMotion(TwoViewResult r, const detail::WeightedMatches& w, const PinholeIntrinsics& K, const TwoViewOptions& o)
+{
+	TwoViewFailure why = TwoViewFailure::None;
+	std::string text;
+	const auto hs = hypotheses(r, K, why, text);
+	if (hs.empty()) return fail(std::move(r), why, text);
+	std::vector<detail::HypothesisCheck> checks;
+	std::size_t best = 0;
+	for (std::size_t k = 0; k < hs.size(); k++)
+	{
+		checks.push_back(detail::checkMotion(hs[k], K, w, r.inliers, o));
+		if (checks[k].good > checks[best].good) best = k;
+	}
+	for (std::size_t k = 0; k < hs.size(); k++)
+		if (k != best) r.secondGood = std::max(r.secondGood, checks[k].good);
+	// The linear estimates (8-point, DLT) are algebraic fits, several times less accurate than
+	// the noise allows, and their gates cut good points: refine the best motion on the
+	// model's inliers (Sampson error, re-gated on the refined motion: see refineMotion) and
+	// check it again; keep whichever explains more points.
+	std::vector<uint8_t> mask = r.inliers;
+	const RelativeMotion refined = detail::refineMotion(hs[best], K, w, mask);
+	auto rc = detail::checkMotion(refined, K, w, mask, o);
+	const bool useRefined = rc.good >= checks[best].good;
+	const auto& b = useRefined ? rc : checks[best];
+	r.motion = useRefined ? refined : hs[best];
+	if (useRefined)
+	{
+		r.inliers = mask;
+		r.numInliers = static_cast<int>(std::count(mask.begin(), mask.end(), uint8_t{1}));
+	}
+	r.bestGood = b.good;
+	r.parallaxDeg = b.medianParallaxDeg;
+	r.numTriangulated = b.numValid;
+	std::ostringstream m;
+	m << toString(r.model) << " (R_H = " << r.ratioH << ", shared inliers " << r.sharedInlierShare << "), " << r.numInliers
+	  << " inliers, best motion " << b.good << " good / " << b.numValid << " triangulated, second " << r.secondGood
+	  << ", median parallax " << b.medianParallaxDeg << " deg";
+	const int minGood = std::max(o.minTriangulated, static_cast<int>(std::ceil(o.minGoodShare * r.numInliers)));
+	if (b.good < o.minTriangulated) return fail(std::move(r), TwoViewFailure::TooFewTriangulated, m.str());
+	if (b.medianParallaxDeg < o.minParallaxDeg) return fail(std::move(r), TwoViewFailure::LowParallax, m.str());
+	if (r.secondGood > o.maxSecondBestShare * checks[best].good) return fail(std::move(r), TwoViewFailure::Ambiguous, m.str());
+	if (b.good < minGood || b.numValid < o.minTriangulated) return fail(std::move(r), TwoViewFailure::TooFewTriangulated, m.str());
+	r.points_ref = b.points_ref;
+	r.triangulated = b.valid;
+	r.ok = true;
+	r.message = "initialized: " + m.str();
+	return r;
+}
+}  // namespace
+
+TwoViewResult TwoViewInitializer::initialize(const TwoViewMatches& matches) const
+{
+	const detail::WeightedMatches w = weigh(matches, m_opts.sigmaPx);
+	TwoViewResult r;
+	const std::size_t n = w.size();
+	if (n < static_cast<std::size_t>(m_opts.minMatches))
+		return fail(r, TwoViewFailure::TooFewMatches, std::to_string(n) + " < min_matches = " + std::to_string(m_opts.minMatches));
+
+	// Same draws for both models; each fit reads only its inputs, so running one of them in
+	// another thread changes nothing in the result.
+	const auto sets = detail::drawMinimalSets(n, m_opts.ransacIterations, m_opts.seed);
+	detail::ModelFit fitH, fitF;
+	if (m_opts.parallel)
+	{
+		auto futureH = std::async(std::launch::async, [&] { return detail::fitHomography(w, sets); });
+		fitF = detail::fitFundamental(w, sets);
+		fitH = futureH.get();
+	}
+	else
+	{
+		fitH = detail::fitHomography(w, sets);
+		fitF = detail::fitFundamental(w, sets);
+	}
+	r.H_cur_ref = fitH.M;
+	r.F_cur_ref = fitF.M;
+	r.scoreH = fitH.score;
+	r.scoreF = fitF.score;
+	if (!(r.scoreH + r.scoreF > 0)) return fail(r, TwoViewFailure::TooFewMatches, "neither model fits any correspondence");
+	r.ratioH = r.scoreH / (r.scoreH + r.scoreF);
+	// F is degenerate when H explains (nearly) every F inlier: see homographyInlierShare.
+	int both = 0;
+	if (fitH.valid && fitF.valid)
+		for (std::size_t i = 0; i < n; i++) both += fitH.inliers[i] & fitF.inliers[i];
+	r.sharedInlierShare = fitF.numInliers > 0 ? static_cast<double>(both) / fitF.numInliers : 0.0;
+	const bool useH = fitH.valid && (!fitF.valid || r.ratioH > m_opts.homographyRatio || r.sharedInlierShare >= m_opts.homographyInlierShare);
+	r.model = useH ? TwoViewModel::Homography : TwoViewModel::Fundamental;
+	const detail::ModelFit& fit = useH ? fitH : fitF;
+	r.inliers = fit.inliers;
+	r.numInliers = fit.numInliers;
+	return chooseMotion(std::move(r), w, m_K, m_opts);
+}
+
+}  // namespace keygrid::sfm
