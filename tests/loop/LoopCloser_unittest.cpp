@@ -77,7 +77,7 @@ class LoopRun
 		m_pointsOf[id] = std::move(pointOf);
 		std::map<sfm::KeyFrameId, CPose3D> before;
 		for (const auto& [kfId, keyframe] : m_map.keyframes()) before[kfId] = keyframe.T_world_cam;
-		if (auto ev = m_loop.process(id, 10 * k, sfm::intrinsicsOf(m_cam)))
+		if (auto ev = m_loop.process(id, 10 * k, m_cam.pinhole()))
 		{
 			const auto& cur = m_map.keyframe(ev->keyframe);
 			const auto& loop = m_map.keyframe(ev->loopKeyFrame);
@@ -128,7 +128,7 @@ class LoopRun
 	void associate(sfm::KeyFrameId id, const std::vector<int>& pointOf)
 	{
 		const auto& kf = m_map.keyframe(id);
-		const auto K = sfm::intrinsicsOf(m_cam);
+		const auto K = m_cam.pinhole();
 		std::vector<sfm::LandmarkId> observed;
 		for (std::size_t kp = 0; kp < pointOf.size(); kp++)
 		{
@@ -140,7 +140,7 @@ class LoopRun
 				observed.push_back(it->second.first);
 				continue;
 			}
-			const Eigen::Vector3d p_cam = sfm::backProject(K, kf.features.undistorted[kp].x, kf.features.undistorted[kp].y, kf.features.depth[kp]);
+			const Eigen::Vector3d p_cam = K.backProject(kf.features.undistorted[kp].x, kf.features.undistorted[kp].y, kf.features.depth[kp]);
 			Eigen::Vector3d p_world;
 			kf.T_world_cam.composePoint(p_cam.x(), p_cam.y(), p_cam.z(), p_world.x(), p_world.y(), p_world.z());
 			m_landmarkOfPoint[pointOf[kp]] = {m_map.addLandmark(p_world, id, static_cast<int>(kp)), id};

@@ -46,7 +46,7 @@ Run track(const std::string& tumDir, const std::optional<std::pair<std::function
 		if (tf.newKeyFrame)
 		{
 			run.keyframeFrames.push_back(tf.index);
-			mapper.process(tf.keyframe, sfm::intrinsicsOf(frame.camera));
+			mapper.process(tf.keyframe, frame.camera.pinhole());
 		}
 	}
 	return run;

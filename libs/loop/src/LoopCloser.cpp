@@ -297,8 +297,8 @@ bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::Pi
 	{
 		const float da = a.features.depth[i], db = b.features.depth[j];
 		if (da <= 0 || db <= 0) continue;
-		pa.push_back(sfm::backProject(K, a.features.undistorted[i].x, a.features.undistorted[i].y, da));
-		pb.push_back(sfm::backProject(K, b.features.undistorted[j].x, b.features.undistorted[j].y, db));
+		pa.push_back(K.backProject(a.features.undistorted[i].x, a.features.undistorted[i].y, da));
+		pb.push_back(K.backProject(b.features.undistorted[j].x, b.features.undistorted[j].y, db));
 	}
 	rec.matches = static_cast<int>(pa.size());
 	if (static_cast<int>(pa.size()) < m_opts.ransac.minInliers)

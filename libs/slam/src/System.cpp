@@ -137,7 +137,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	throwIfBackgroundFailed();
 	std::unique_lock<std::mutex> lock(m_map.mutex());
 	auto t0 = std::chrono::steady_clock::now();
-	const sfm::PinholeIntrinsics K = sfm::intrinsicsOf(features.camera);
+	const sfm::PinholeIntrinsics K = features.camera.pinhole();
 	if (!m_K) m_K = K;
 	sfm::TrackedFrame tf = m_tracker.track(frame, std::move(features));
 	m_timings.add("track", secondsSince(t0));

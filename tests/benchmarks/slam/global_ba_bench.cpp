@@ -54,7 +54,7 @@ int main(int argc, char** argv)
 		const auto cfg = slam::SlamConfig::FromConfig(mrpt::config::CConfigFileMemory(text), cl.get("config"));
 		const auto gt = core::readTumTrajectory(cl.get("gt"));
 		const auto session = store::SessionStore::Open(cl.get("session"));
-		const auto K = sfm::intrinsicsOf(session.meta().camera);
+		const auto K = session.meta().camera.pinhole();
 		const long repeat = cl.getInt("repeat");
 		for (long r = 0; r < repeat; r++)
 		{

@@ -30,7 +30,7 @@
 namespace keygrid::sfm
 {
 /** The undistorted image's pinhole model (core/PinholeIntrinsics.h: why it is apart from
- * core::RgbdCamera); sfm::intrinsicsOf() converts a camera. */
+ * core::RgbdCamera); core::RgbdCamera::pinhole() converts a camera. */
 using PinholeIntrinsics = core::PinholeIntrinsics;
 
 /** Pixel (and virtual right pixel) of p_world seen from T_cam_world; returns false behind. */

@@ -220,9 +220,4 @@ class Tracker
 	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
 };
 
-/** K.backProject(u, v, depth): an undistorted pixel with depth in the camera frame. */
-inline Eigen::Vector3d backProject(const PinholeIntrinsics& K, float u, float v, float depth) { return K.backProject(u, v, depth); }
-/** cam.pinhole() */
-inline PinholeIntrinsics intrinsicsOf(const core::RgbdCamera& cam) { return cam.pinhole(); }
-
 }  // namespace keygrid::sfm
