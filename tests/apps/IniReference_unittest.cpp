@@ -81,14 +81,19 @@ TEST(IniReference, ListsEverySlamConfigKeyWithItsDefault)
 	EXPECT_EQ(comment, "detect and correct loops");
 }
 
-// Every key of keygrid-slam's sections and of the plugins whose options are OptionFields tables
-// has a description.
+// Every key of keygrid-slam's sections and of every keygrid map plugin has a description.
 TEST(IniReference, EveryKeyIsDescribed)
 {
 	std::vector<IniSection> sections = slamConfigReference();
-	const auto hoc = mapPluginReference("hocPointsMap");
-	ASSERT_TRUE(hoc.has_value());
-	sections.insert(sections.end(), hoc->begin(), hoc->end());
+	const auto plugins = keygridMapPluginNames();
+	for (const std::string expected : {"hocPointsMap", "ismOccupancyGrid2D", "submappedOccupancyGrid3D"})
+		EXPECT_NE(std::find(plugins.begin(), plugins.end(), expected), plugins.end()) << expected;
+	for (const auto& name : plugins)
+	{
+		const auto ref = mapPluginReference(name);
+		ASSERT_TRUE(ref.has_value()) << name;
+		sections.insert(sections.end(), ref->begin(), ref->end());
+	}
 	for (const auto& s : sections)
 		for (const auto& k : s.keys) EXPECT_FALSE(k.description.empty()) << "[" << s.name << "] " << k.key;
 }

@@ -14,6 +14,7 @@
 #include <limits>
 
 #include "ISMSyntheticRoom.h"
+#include "MapIniChecks.h"
 #include "TestData.h"
 
 using keygrid::CellState;
@@ -128,8 +129,13 @@ TEST(CISMOccupancyGrid2D, OptionsSaveLoadRoundTripAndErrorsNameTheKey)
 	a.rayTraversal = CISMOccupancyGrid2D::RayTraversal::AntiAliased;
 	a.T_world_floor = mrpt::poses::CPose3D(1, 2, 3, 0.1, 0.2, 0.3);
 	a.floorRansac.iterations = 77;
-	mrpt::config::CConfigFileMemory cfg;
-	a.saveToConfigFile(cfg, "ins");
+	a.floorUpHint = mrpt::math::TVector3D(0, 0.5, 1);
+	a.estimateFloorFromDepth = true;
+	a.freeSpaceModel = CISMOccupancyGrid2D::FreeSpaceModel::Paper;
+	mrpt::config::CConfigFileMemory saved;
+	a.saveToConfigFile(saved, "ins");
+	// Through the INI text: the written lines are padded and carry their description.
+	const mrpt::config::CConfigFileMemory cfg(saved.getContent());
 	CISMOccupancyGrid2D::TInsertionOptions b;
 	b.loadFromConfigFile(cfg, "ins");
 	EXPECT_DOUBLE_EQ(b.pOccupied, 0.8);
@@ -138,6 +144,9 @@ TEST(CISMOccupancyGrid2D, OptionsSaveLoadRoundTripAndErrorsNameTheKey)
 	EXPECT_EQ(b.rayTraversal, CISMOccupancyGrid2D::RayTraversal::AntiAliased);
 	EXPECT_EQ(b.floorRansac.iterations, 77);
 	EXPECT_NEAR((b.T_world_floor - a.T_world_floor).translation().norm(), 0.0, 1e-6);
+	EXPECT_DOUBLE_EQ(b.floorUpHint.y, 0.5);
+	EXPECT_TRUE(b.estimateFloorFromDepth);
+	EXPECT_EQ(b.freeSpaceModel, CISMOccupancyGrid2D::FreeSpaceModel::Paper);
 
 	mrpt::config::CConfigFileMemory bad;
 	bad.write("ins", "rayTraversal", "zigzag");
@@ -224,6 +233,32 @@ decimation = 4
 	{
 		EXPECT_NE(std::string(e.what()).find("maxRange"), std::string::npos) << e.what();
 	}
+}
+
+// A bad value in any of the grid's INI sections throws naming that section and the key; MRPT's
+// yes/no booleans and any letter case of rangeNoise are still read.
+TEST(CISMOccupancyGrid2D, BadIniValueNamesSectionAndKey)
+{
+	const std::string prefix = "map_ismOccupancyGrid2D_00";
+	keygrid::test::expectBadValuesNameSectionAndKey<CISMOccupancyGrid2D::TMapDefinition>(
+		prefix, {
+			{"_creationOpts", "resolution = 0"},
+			{"_creationOpts", "max_x = -6"},
+			{"_insertOpts", "pFree = 1.5"},
+			{"_insertOpts", "pFree = 0.6"},
+			{"_insertOpts", "freeSpaceModel = bogus"},
+			{"_insertOpts", "rangeNoise = laser"},
+			{"_insertOpts", "T_world_floor = [1 2]"},
+			{"_insertOpts", "floorUpHint = 0 1"},
+			{"_insertOpts", "floorRansac_maxTiltDeg = 90"},
+			{"_insertOpts", "estimateFloorFromDepth = maybe"},
+			{"_insertOpts", "depthDecimation = 1.5"},
+			{"_likelihoodOpts", "outlierProbability = 1"}});
+	mrpt::config::CConfigFileMemory ini("[" + prefix + "_insertOpts]\nrangeNoise = Constant\nestimateFloorFromDepth = yes\n");
+	CISMOccupancyGrid2D::TMapDefinition def;
+	def.loadFromConfigFile(ini, prefix);
+	EXPECT_EQ(def.insertionOpts.rangeNoise, keygrid::maps::RangeNoiseModel::Constant);
+	EXPECT_TRUE(def.insertionOpts.estimateFloorFromDepth);
 }
 
 TEST(CISMOccupancyGrid2D, RealKinectFrameLandsInFrontOfTheSensor)

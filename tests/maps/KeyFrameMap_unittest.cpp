@@ -131,6 +131,60 @@ TEST(KeyFrameMap, DepthKeyFramesWaitForTheFloorFrameAndComeBackAsTheyAreNow)
 	}
 }
 
+/* The move of the grid's box under a new floor frame, in closed form: a floor raised by 3 mm
+ * moves every point by 3 mm; a floor turned by theta about its z axis moves the box corners
+ * (+-5, +-5) most, by the chord 2 sin(theta / 2) |(5, 5)|. */
+TEST(KeyFrameMap, FloorFrameShiftIsTheLargestMoveOfTheGridBox)
+{
+	CISMOccupancyGrid2D grid = paperGrid();  // x, y in [-5, 5] m
+	grid.setExternalFloorPose(CPose3D());
+	EXPECT_NEAR(grid.floorFrameShift(CPose3D(0, 0, 0.003, 0, 0, 0)), 0.003, 1e-12);
+	const double theta = 0.001;
+	EXPECT_NEAR(grid.floorFrameShift(CPose3D(0, 0, 0, theta, 0, 0)), 2 * std::sin(theta / 2) * std::sqrt(50.0), 1e-12);
+	EXPECT_EQ(grid.floorFrameShift(CPose3D()), 0.0);
+}
+
+/* A new floor frame that moves the grid by at most floorReanchorShift keeps the grid as it is
+ * (its floor frame and cells); a larger one re-integrates every keyframe in the new frame,
+ * cell for cell what a grid built in that frame holds. */
+TEST(KeyFrameMap, SmallFloorChangesKeepTheGridLargerOnesRebuildIt)
+{
+	CISMOccupancyGrid2D grid = paperGrid();
+	grid.insertionOptions.floorReanchorShift = 0.01;
+	maps::KeyFrameMap& map = grid;
+	map.setFloorFrame(CPose3D());
+	maps::MapKeyFrame kf;
+	kf.id = 1;
+	kf.T_world_cam = levelCameraAt(0.025);
+	kf.points_world = {TPoint3D(1.025, 0.025, 0.5), TPoint3D(1.025, 0.525, 0.5), TPoint3D(0.525, -0.475, 0.3)};
+	map.insertKeyFrame(kf, maps::KeyFrameFeed{});
+	const auto cellsOf = [](const CISMOccupancyGrid2D& g) {
+		std::vector<float> v;
+		for (int cy = 0; cy < g.sizeY(); cy++)
+			for (int cx = 0; cx < g.sizeX(); cx++) v.push_back(g.logOdds(cx, cy));
+		return v;
+	};
+	const auto before = cellsOf(grid);
+
+	const CPose3D small(0, 0, 0.008, 0, 0, 0);  // moves the box by 8 mm
+	map.setFloorFrame(small);
+	EXPECT_EQ(grid.floorPose(), CPose3D());
+	EXPECT_EQ(cellsOf(grid), before);
+
+	// 10 cm along x and 5 cm up: every mark moves two cells back.
+	const CPose3D large(0.1, 0, 0.05, 0, 0, 0);
+	map.setFloorFrame(large);
+	EXPECT_EQ(grid.floorPose(), large);
+	CISMOccupancyGrid2D fresh = paperGrid();
+	maps::KeyFrameMap& freshMap = fresh;
+	freshMap.setFloorFrame(large);
+	freshMap.insertKeyFrame(kf, maps::KeyFrameFeed{});
+	ASSERT_EQ(fresh.sizeX(), grid.sizeX());
+	ASSERT_EQ(fresh.sizeY(), grid.sizeY());
+	EXPECT_EQ(cellsOf(grid), cellsOf(fresh));
+	EXPECT_NE(cellsOf(grid), before);
+}
+
 TEST(KeyFrameMap, AGridsOwnFloorPoseIsRefusedNamingTheKey)
 {
 	CISMOccupancyGrid2D grid;

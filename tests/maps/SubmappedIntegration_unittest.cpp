@@ -193,8 +193,9 @@ TEST(SubmappedIntegration, OptionsValidateAndRoundTrip)
 	a.logOddsMax = 2.5f;
 	a.discretizeEndpoints = false;
 	a.maxDenseMarkVoxels = 4096.0;
-	mrpt::config::CConfigFileMemory ini;
-	a.saveToConfigFile(ini, "integration");
+	mrpt::config::CConfigFileMemory saved;
+	a.saveToConfigFile(saved, "integration");
+	const mrpt::config::CConfigFileMemory ini(saved.getContent());  // through the INI text
 	DepthIntegrationOptions b;
 	b.loadFromConfigFile(ini, "integration");
 	EXPECT_DOUBLE_EQ(b.maxRange, a.maxRange);
@@ -226,7 +227,7 @@ TEST(SubmappedIntegration, ResolutionOutsideItsRangeIsRefusedNamingTheKey)
 		}
 		catch (const std::invalid_argument& e)
 		{
-			EXPECT_NE(std::string(e.what()).find("m_creationOpts/resolution"), std::string::npos) << e.what();
+			EXPECT_NE(std::string(e.what()).find("[m_creationOpts] resolution"), std::string::npos) << e.what();
 		}
 	}
 	for (const double r : {CSubmappedOccupancyGrid3D::kMinResolution, 0.05, CSubmappedOccupancyGrid3D::kMaxResolution})

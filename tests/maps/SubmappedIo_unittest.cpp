@@ -2,6 +2,7 @@
  * creation from an INI through CMultiMetricMap, OctoMap .bt export re-read with OcTree, PLY,
  * visualization, and insertObservation() of the real Kinect frame of tests_rgbd.rawlog. */
 #include "Grid3DTestScenes.h"
+#include "MapIniChecks.h"
 #include "TestData.h"
 
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
@@ -135,7 +136,7 @@ decimation=5
 	mrpt::config::CConfigFileMemory out;
 	m->insertionOptions.saveToConfigFile(out, "ins");
 	CSubmappedOccupancyGrid3D::TInsertionOptions back;
-	back.loadFromConfigFile(out, "ins");
+	back.loadFromConfigFile(mrpt::config::CConfigFileMemory(out.getContent()), "ins");  // through the INI text
 	EXPECT_DOUBLE_EQ(back.integration.maxRange, 3.5);
 	EXPECT_TRUE(back.storeKeyframeDepth);
 	// (Through the map definition directly: TSetOfMetricMapInitializers leaks the initializer
@@ -165,6 +166,28 @@ decimation=5
 		EXPECT_NE(std::string(e.what()).find("morphInterpolation"), std::string::npos) << e.what();
 		EXPECT_NE(std::string(e.what()).find("cubic"), std::string::npos) << e.what();
 	}
+}
+
+// A bad value in any of the grid's INI sections throws naming that section and the key; MRPT's
+// yes/no booleans are still read.
+TEST(SubmappedIo, BadIniValueNamesSectionAndKey)
+{
+	const std::string prefix = "map_submappedOccupancyGrid3D_00";
+	keygrid::test::expectBadValuesNameSectionAndKey<CSubmappedOccupancyGrid3D::TMapDefinition>(
+		prefix, {
+			{"_creationOpts", "resolution = 0"},
+			{"_insertOpts", "minRange = 5"},
+			{"_insertOpts", "logOddsMiss = 0.1"},
+			{"_insertOpts", "maxDenseMarkVoxels = 100"},
+			{"_insertOpts", "localizationExitHitFraction = 1.5"},
+			{"_insertOpts", "storeKeyframeDepth = maybe"},
+			{"_insertOpts", "morphInterpolation = cubic"},
+			{"_likelihoodOpts", "minProbability = 0.5"}});
+	mrpt::config::CConfigFileMemory ini("[" + prefix + "_insertOpts]\nstoreKeyframeDepth = yes\ndiscretizeEndpoints = no\n");
+	CSubmappedOccupancyGrid3D::TMapDefinition def;
+	def.loadFromConfigFile(ini, prefix);
+	EXPECT_TRUE(def.insertionOpts.storeKeyframeDepth);
+	EXPECT_FALSE(def.insertionOpts.integration.discretizeEndpoints);
 }
 
 TEST(SubmappedIo, OctomapExportAgreesVoxelByVoxel)

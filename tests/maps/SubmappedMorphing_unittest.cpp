@@ -354,7 +354,7 @@ TEST(SubmappedMorphing, KeyframeLimitIniRoundTripAndValidation)
 	mrpt::config::CConfigFileMemory saved;
 	o.saveToConfigFile(saved, sec);
 	MorphingOptions back;
-	back.loadFromConfigFile(saved, sec);
+	back.loadFromConfigFile(mrpt::config::CConfigFileMemory(saved.getContent()), sec);  // through the INI text
 	EXPECT_EQ(back.maxKeyframesPerBlock, 12u);
 	for (const char* bad : {"-1", "2.5", "abc"})
 	{

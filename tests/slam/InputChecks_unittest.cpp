@@ -104,7 +104,7 @@ TEST(InputChecks, ErrorsFromInsideMrptAreOneReadableLine)
 	std::ofstream(dir + "/fine.ini") << "[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
 									 << "[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.001\n";
 	EXPECT_EQ(test::runCommand(tool + " --config " + dir + "/fine.ini --input " + dir + "/one.rawlog --output " + dir + "/out", &out), 1);
-	EXPECT_NE(out.find("keygrid-slam: error: MappingApplication_submappedOccupancyGrid3D_00_creationOpts/resolution = 0.001000: must be in [0.005000, 10.000000] m"),
+	EXPECT_NE(out.find("keygrid-slam: error: [MappingApplication_submappedOccupancyGrid3D_00_creationOpts] resolution = 0.001 (must be in [0.005, 10])\n"),
 			  std::string::npos)
 		<< out;
 	EXPECT_EQ(out.find("0x"), std::string::npos) << "no backtrace address: " << out;

@@ -113,35 +113,35 @@ RigidRansacOptions LoopClosingOptions::verificationRansacDefaults()
 	return o;
 }
 
+core::OptionFields LoopClosingOptions::fields()
+{
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("enabled", enabled, "detect and correct loops");
+	f.add("vocabulary", vocabulary, "default (shipped, ORB), train (first keyframes), or a file", R::nonEmpty());
+	f.add("train_keyframes", trainKeyFrames, "keyframes that train the vocabulary", R::atLeast(2));
+	f.add("vocabulary_branching", vocabularyOptions.branching, "k of the in-run (train) vocabulary", R::atLeast(2));
+	f.add("vocabulary_levels", vocabularyOptions.levels, "L of the in-run (train) vocabulary", R::atLeast(1));
+	f.add("min_keyframe_gap", minKeyFrameGap, "candidates at least this many keyframes older", R::atLeast(1));
+	f.add("consistency", consistency, "consecutive keyframes agreeing on a candidate", R::atLeast(1));
+	f.add("min_inliers", ransac.minInliers, "3D-3D RANSAC inliers to accept a loop", R::atLeast(3));
+	f.add("inlier_threshold", ransac.inlierThreshold, "[m]", R::positive());
+	f.add("covisibility_edge_min_weight", covisibilityEdgeMinWeight, "pose-graph covisibility edges");
+	f.add("max_correction_base", maxCorrectionBase, "[m] largest loop correction: base +", R::atLeast(0));
+	f.add("max_correction_ratio", maxCorrectionRatio, "... ratio x path between the keyframes", R::atLeast(0));
+	f.add("max_correction_deg", maxCorrectionDeg, "[deg] largest loop rotation correction", R::positive());
+	f.add("merge_consistency", mergeConsistency, "verified loops agreeing on a map merge", R::atLeast(1));
+	f.add("merge_tolerance_m", mergeToleranceMetres, "[m] how far their alignments may differ", R::positive());
+	f.add("merge_tolerance_deg", mergeToleranceDeg, "[deg] ... and in rotation", R::positive());
+	f.add("merge_max_seen_through", mergeMaxSeenThrough, "largest share of landmarks seen through for a merge", R::inRange(0, 1));
+	return f;
+}
+
 void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	enabled = c.read_bool(s, "enabled", enabled);
-	vocabulary = c.read_string(s, "vocabulary", vocabulary);
-	if (vocabulary.empty()) throw std::invalid_argument("[" + s + "] vocabulary is empty (default, train, or a file)");
-	trainKeyFrames = c.read_int(s, "train_keyframes", trainKeyFrames);
-	minKeyFrameGap = c.read_int(s, "min_keyframe_gap", minKeyFrameGap);
-	consistency = c.read_int(s, "consistency", consistency);
-	ransac.minInliers = c.read_int(s, "min_inliers", ransac.minInliers);
-	ransac.inlierThreshold = c.read_double(s, "inlier_threshold", ransac.inlierThreshold);
-	covisibilityEdgeMinWeight = c.read_int(s, "covisibility_edge_min_weight", covisibilityEdgeMinWeight);
-	maxCorrectionBase = c.read_double(s, "max_correction_base", maxCorrectionBase);
-	maxCorrectionRatio = c.read_double(s, "max_correction_ratio", maxCorrectionRatio);
-	maxCorrectionDeg = c.read_double(s, "max_correction_deg", maxCorrectionDeg);
-	if (!(maxCorrectionBase >= 0 && maxCorrectionRatio >= 0 && maxCorrectionDeg > 0))
-		throw std::invalid_argument("[" + s + "] max_correction_base/_ratio must be >= 0 and max_correction_deg > 0");
-	mergeConsistency = c.read_int(s, "merge_consistency", mergeConsistency);
-	mergeToleranceMetres = c.read_double(s, "merge_tolerance_m", mergeToleranceMetres);
-	mergeToleranceDeg = c.read_double(s, "merge_tolerance_deg", mergeToleranceDeg);
-	mergeMaxSeenThrough = c.read_double(s, "merge_max_seen_through", mergeMaxSeenThrough);
-	if (!(mergeMaxSeenThrough >= 0 && mergeMaxSeenThrough <= 1))
-		throw std::invalid_argument("[" + s + "] merge_max_seen_through = " + std::to_string(mergeMaxSeenThrough) + " (must be in [0, 1])");
-	if (mergeConsistency < 1) throw std::invalid_argument("[" + s + "] merge_consistency = " + std::to_string(mergeConsistency) + " (must be >= 1)");
-	if (!(mergeToleranceMetres > 0 && mergeToleranceDeg > 0)) throw std::invalid_argument("[" + s + "] merge_tolerance_m and merge_tolerance_deg must be > 0");
-	vocabularyOptions.branching = c.read_int(s, "vocabulary_branching", vocabularyOptions.branching);
-	vocabularyOptions.levels = c.read_int(s, "vocabulary_levels", vocabularyOptions.levels);
-	if (trainKeyFrames < 2) throw std::invalid_argument("[" + s + "] train_keyframes = " + std::to_string(trainKeyFrames) + " (must be >= 2)");
-	if (consistency < 1) throw std::invalid_argument("[" + s + "] consistency = " + std::to_string(consistency) + " (must be >= 1)");
-	if (minKeyFrameGap < 1) throw std::invalid_argument("[" + s + "] min_keyframe_gap must be >= 1");
+	fields().read(c, s);
+	core::validateFields(*this, s);
+	// The vocabulary's size and the verification's other parameters.
 	std::string why;
 	if (!ransac.isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
 	if (!vocabularyOptions.isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
@@ -149,23 +149,7 @@ void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 
 void LoopClosingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	c.write(s, "enabled", enabled, 30, 40, "detect and correct loops");
-	c.write(s, "vocabulary", vocabulary, 30, 40, "default (shipped, ORB), train (first keyframes), or a file");
-	c.write(s, "train_keyframes", trainKeyFrames, 30, 40, "keyframes that train the vocabulary");
-	c.write(s, "vocabulary_branching", vocabularyOptions.branching, 30, 40, "k of the in-run (train) vocabulary");
-	c.write(s, "vocabulary_levels", vocabularyOptions.levels, 30, 40, "L of the in-run (train) vocabulary");
-	c.write(s, "min_keyframe_gap", minKeyFrameGap, 30, 40, "candidates at least this many keyframes older");
-	c.write(s, "consistency", consistency, 30, 40, "consecutive keyframes agreeing on a candidate");
-	c.write(s, "min_inliers", ransac.minInliers, 30, 40, "3D-3D RANSAC inliers to accept a loop");
-	c.write(s, "inlier_threshold", ransac.inlierThreshold, 30, 40, "[m]");
-	c.write(s, "covisibility_edge_min_weight", covisibilityEdgeMinWeight, 30, 40, "pose-graph covisibility edges");
-	c.write(s, "max_correction_base", maxCorrectionBase, 30, 40, "[m] largest loop correction: base +");
-	c.write(s, "max_correction_ratio", maxCorrectionRatio, 30, 40, "... ratio x path between the keyframes");
-	c.write(s, "max_correction_deg", maxCorrectionDeg, 30, 40, "[deg] largest loop rotation correction");
-	c.write(s, "merge_consistency", mergeConsistency, 30, 40, "verified loops agreeing on a map merge");
-	c.write(s, "merge_tolerance_m", mergeToleranceMetres, 30, 40, "[m] how far their alignments may differ");
-	c.write(s, "merge_tolerance_deg", mergeToleranceDeg, 30, 40, "[deg] ... and in rotation");
-	c.write(s, "merge_max_seen_through", mergeMaxSeenThrough, 30, 40, "largest share of landmarks seen through for a merge");
+	core::writeFields(*this, c, s);
 }
 
 LoopCloser::LoopCloser(

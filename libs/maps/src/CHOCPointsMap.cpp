@@ -3,7 +3,6 @@
  * likelihood. Serialization, PLY and visualization are in CHOCPointsMap_io.cpp.
  */
 #include "detail/DepthOfScan.h"
-#include "detail/Grid3DConfig.h"
 
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/CHOCPointsMap.h>

@@ -41,6 +41,7 @@ void writeOptions(CArchive& out, const CISMOccupancyGrid2D::TInsertionOptions& o
 	out << static_cast<uint8_t>(o.rayTraversal) << static_cast<int32_t>(o.depthDecimation)
 		<< static_cast<int32_t>(o.minPointsPerCell) << o.occupiedThreshold << o.freeThreshold;
 	out << static_cast<uint8_t>(o.freeSpaceModel) << o.bandSliceHeight;  // since version 1
+	out << o.floorReanchorShift;  // since version 2
 }
 void readOptions(CArchive& in, CISMOccupancyGrid2D::TInsertionOptions& o, uint8_t version)
 {
@@ -72,10 +73,13 @@ void readOptions(CArchive& in, CISMOccupancyGrid2D::TInsertionOptions& o, uint8_
 		if (model > 1) throw std::runtime_error("CISMOccupancyGrid2D: corrupt freeSpaceModel in serialized options");
 		o.freeSpaceModel = static_cast<CISMOccupancyGrid2D::FreeSpaceModel>(model);
 	}
+	// Older grids take the compiled-in default (it only decides future floor changes).
+	o.floorReanchorShift = CISMOccupancyGrid2D::TInsertionOptions().floorReanchorShift;
+	if (version >= 2) in >> o.floorReanchorShift;
 }
 }  // namespace
 
-uint8_t CISMOccupancyGrid2D::serializeGetVersion() const { return 1; }
+uint8_t CISMOccupancyGrid2D::serializeGetVersion() const { return 2; }
 
 void CISMOccupancyGrid2D::serializeTo(CArchive& out) const
 {
@@ -106,6 +110,7 @@ void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
 	{
 		case 0:
 		case 1:
+		case 2:
 		{
 			readOptions(in, creationOptions);
 			readOptions(in, insertionOptions, version);

@@ -5,6 +5,7 @@
 #include <keygrid/core/AtomicOutput.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 
@@ -56,9 +57,30 @@ void CISMOccupancyGrid2D::setFloorFrame(const std::optional<mrpt::poses::CPose3D
 		expectExternalFloorPose();
 		return;
 	}
+	// Re-integrating every keyframe costs as much as the whole map; a floor estimate that
+	// moves the grid by less than floorReanchorShift is not worth it.
+	// (Sparse keyframes stored before the first floor frame are integrated now.)
+	if (floorKnown() && !m_keyframes.empty() && floorFrameShift(*T_world_floor) <= io.floorReanchorShift) return;
 	setExternalFloorPose(*T_world_floor);
-	// The keyframes integrated so far, again in the new floor frame (cheap).
 	if (!m_keyframes.empty()) applyTrajectoryCorrection({});
+}
+
+/* A point q of the grid's box (old floor frame) has coordinates D q = R q + t in the new
+ * frame, D = inv(T_world_floor_new) (+) T_world_floor_old. Its move |(R - I) q + t| is a
+ * convex function of q, so the largest move over the box is at one of its eight corners. */
+double CISMOccupancyGrid2D::floorFrameShift(const mrpt::poses::CPose3D& T_world_floor) const
+{
+	const mrpt::poses::CPose3D D = floorPose() - T_world_floor;  // a - b = inv(b) (+) a
+	const double zs[2] = {-insertionOptions.floorTolerance, insertionOptions.obstacleMaxHeight};
+	double largest = 0;
+	for (const double x : {xMin(), xMax()})
+		for (const double y : {yMin(), yMax()})
+			for (const double z : zs)
+			{
+				const mrpt::math::TPoint3D q(x, y, z);
+				largest = std::max(largest, (D.composePoint(q) - q).norm());
+			}
+	return largest;
 }
 
 void CISMOccupancyGrid2D::writeOutputs(maps::MapOutputFolder& out, const std::string& suffix) const

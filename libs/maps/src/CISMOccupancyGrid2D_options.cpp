@@ -1,65 +1,58 @@
 /** \file CISMOccupancyGrid2D_options.cpp
- * Creation / insertion / likelihood options of CISMOccupancyGrid2D: INI load and save,
- * validation (an invalid value throws naming the key and the value).
+ * Creation / insertion / likelihood options of CISMOccupancyGrid2D: their INI tables
+ * (core::OptionFields) and the checks that relate two fields. An invalid value throws naming
+ * [section], key and value.
  */
+#include "detail/OptionValues.h"
+
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 
 #include <cmath>
-#include <sstream>
 #include <stdexcept>
 
 namespace keygrid
 {
 namespace
 {
-[[noreturn]] void badKey(const std::string& section, const std::string& key, const std::string& v,
-	const std::string& why)
+/** The error of a check between two fields, in the form of core::OptionFields' errors. */
+[[noreturn]] void badValue(const std::string& section, const std::string& key, double value, const std::string& rule)
 {
-	throw std::invalid_argument(
-		"[" + section + "] " + key + " = " + v + " is invalid: " + why);
+	throw std::invalid_argument("[" + section + "] " + key + " = " + std::to_string(value) + " (must be " + rule + ")");
 }
-std::string str(double v) { return std::to_string(v); }
 }  // namespace
 
 // ------------------------------------------------------------------ creation
-void CISMOccupancyGrid2D::TCreationOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields CISMOccupancyGrid2D::TCreationOptions::fields()
 {
-	resolution = c.read_double(s, "resolution", resolution);
-	min_x = c.read_double(s, "min_x", min_x);
-	max_x = c.read_double(s, "max_x", max_x);
-	min_y = c.read_double(s, "min_y", min_y);
-	max_y = c.read_double(s, "max_y", max_y);
-	growthMargin = c.read_double(s, "growthMargin", growthMargin);
-	try
-	{
-		validate();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw std::invalid_argument("[" + s + "] " + e.what());
-	}
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("resolution", resolution, "cell edge [m]", R::between(0, 10));
+	f.add("min_x", min_x, "initial extent in the floor frame, lowest x [m]; the grid grows to hold every ray");
+	f.add("max_x", max_x, "initial extent, highest x [m] (> min_x)");
+	f.add("min_y", min_y, "initial extent, lowest y [m]");
+	f.add("max_y", max_y, "initial extent, highest y [m] (> min_y)");
+	f.add("growthMargin", growthMargin, "a growing grid extends this far beyond the rays that made it grow [m]", R::atLeast(0));
+	return f;
 }
 
-void CISMOccupancyGrid2D::TCreationOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void CISMOccupancyGrid2D::TCreationOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "resolution", resolution);
-	c.write(s, "min_x", min_x);
-	c.write(s, "max_x", max_x);
-	c.write(s, "min_y", min_y);
-	c.write(s, "max_y", max_y);
-	c.write(s, "growthMargin", growthMargin);
+	fields().read(c, s);
+	validate(s);
 }
 
-void CISMOccupancyGrid2D::TCreationOptions::validate() const
+void CISMOccupancyGrid2D::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	if (!(resolution > 0 && resolution < 10)) badKey("creationOpts", "resolution", str(resolution), "must be in (0, 10) m");
-	if (!(max_x > min_x)) badKey("creationOpts", "max_x", str(max_x), "must exceed min_x = " + str(min_x));
-	if (!(max_y > min_y)) badKey("creationOpts", "max_y", str(max_y), "must exceed min_y = " + str(min_y));
-	if (!(growthMargin >= 0)) badKey("creationOpts", "growthMargin", str(growthMargin), "must be >= 0");
+	core::writeFields(*this, c, s);
+}
+
+void CISMOccupancyGrid2D::TCreationOptions::validate(const std::string& s) const
+{
+	core::validateFields(*this, s);
+	if (!(max_x > min_x)) badValue(s, "max_x", max_x, "> min_x = " + std::to_string(min_x));
+	if (!(max_y > min_y)) badValue(s, "max_y", max_y, "> min_y = " + std::to_string(min_y));
 	const double cells = (max_x - min_x) / resolution * (max_y - min_y) / resolution;
-	if (!(cells < 2.0e8)) badKey("creationOpts", "resolution", str(resolution), "extent has too many cells");
+	if (!(cells < 2.0e8)) badValue(s, "resolution", resolution, "coarse enough for fewer than 2e8 cells in the initial extent");
 }
 
 // ------------------------------------------------------------------ insertion
@@ -73,168 +66,126 @@ maps::IsmShape CISMOccupancyGrid2D::TInsertionOptions::ismShape(double resolutio
 	return s;
 }
 
-void CISMOccupancyGrid2D::TInsertionOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields CISMOccupancyGrid2D::TInsertionOptions::fields()
 {
-	pFree = c.read_double(s, "pFree", pFree);
-	pOccupied = c.read_double(s, "pOccupied", pOccupied);
-	pPrior = c.read_double(s, "pPrior", pPrior);
-	bandWidth = c.read_double(s, "bandWidth", bandWidth);
-	const std::string noise = c.read_string(s, "rangeNoise", maps::toString(rangeNoise));
-	try
-	{
-		rangeNoise = maps::rangeNoiseModelFromString(noise);
-	}
-	catch (const std::invalid_argument&)
-	{
-		badKey(s, "rangeNoise", noise, "expected 'constant' or 'kinect'");
-	}
-	sigmaConstant = c.read_double(s, "sigmaConstant", sigmaConstant);
-	logOddsMin = c.read_double(s, "logOddsMin", logOddsMin);
-	logOddsMax = c.read_double(s, "logOddsMax", logOddsMax);
-	maxRange = c.read_double(s, "maxRange", maxRange);
-	obstacleMinHeight = c.read_double(s, "obstacleMinHeight", obstacleMinHeight);
-	obstacleMaxHeight = c.read_double(s, "obstacleMaxHeight", obstacleMaxHeight);
-	floorTolerance = c.read_double(s, "floorTolerance", floorTolerance);
-	const std::string pose = c.read_string(s, "T_world_floor", "");
-	if (!pose.empty())
-	{
-		try
-		{
-			T_world_floor.fromString(pose);
-		}
-		catch (const std::exception&)
-		{
-			badKey(s, "T_world_floor", pose, "expected \"[x y z yaw pitch roll]\" (m, deg)");
-		}
-	}
-	estimateFloorFromDepth = c.read_bool(s, "estimateFloorFromDepth", estimateFloorFromDepth);
-	const std::string up = c.read_string(s, "floorUpHint", "");
-	if (!up.empty())
-	{
-		std::istringstream is(up);
-		double x = 0, y = 0, z = 0;
-		if (!(is >> x >> y >> z)) badKey(s, "floorUpHint", up, "expected three numbers \"x y z\"");
-		floorUpHint = mrpt::math::TVector3D(x, y, z);
-	}
-	floorRansac.loadFromConfigFile(c, s);
-	const std::string model = c.read_string(s, "freeSpaceModel", freeSpaceModel == FreeSpaceModel::HeightBand ? "heightBand" : "paper");
-	if (model == "heightBand") freeSpaceModel = FreeSpaceModel::HeightBand;
-	else if (model == "paper")
-		freeSpaceModel = FreeSpaceModel::Paper;
-	else
-		badKey(s, "freeSpaceModel", model, "expected 'heightBand' or 'paper'");
-	bandSliceHeight = c.read_double(s, "bandSliceHeight", bandSliceHeight);
-	const std::string trav = c.read_string(s, "rayTraversal", rayTraversal == RayTraversal::Bresenham ? "bresenham" : "antialiased");
-	if (trav == "bresenham") rayTraversal = RayTraversal::Bresenham;
-	else if (trav == "antialiased")
-		rayTraversal = RayTraversal::AntiAliased;
-	else
-		badKey(s, "rayTraversal", trav, "expected 'bresenham' or 'antialiased'");
-	depthDecimation = c.read_int(s, "depthDecimation", depthDecimation);
-	minPointsPerCell = c.read_int(s, "minPointsPerCell", minPointsPerCell);
-	occupiedThreshold = c.read_double(s, "occupiedThreshold", occupiedThreshold);
-	freeThreshold = c.read_double(s, "freeThreshold", freeThreshold);
-	try
-	{
-		validate();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw std::invalid_argument("[" + s + "] " + e.what());
-	}
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("pFree", pFree, "ideal ISM: occupancy of the cells nearer than the band, r < z - L/2 (< pPrior)", R::between(0, 1));
+	f.add("pOccupied", pOccupied, "ideal ISM: occupancy inside the band around the measured range z, |r - z| <= L/2 (> pPrior)", R::between(0, 1));
+	f.add("pPrior", pPrior, "prior occupancy p0: unknown cells, and the ISM beyond the band; l0 = logit(p0)", R::between(0, 1));
+	f.add("bandWidth", bandWidth, "width L of the ISM's occupied band [m]; 0 = the cell diagonal, resolution*sqrt(2)", R::atLeast(0));
+	f.addCustom(
+		"rangeNoise",
+		{[this](const std::string& text) {
+			 try
+			 {
+				 rangeNoise = maps::rangeNoiseModelFromString(text);  // any letter case
+			 }
+			 catch (const std::invalid_argument&)
+			 {
+				 throw std::invalid_argument("expected 'constant' or 'kinect'");
+			 }
+		 },
+		 [this] { return maps::toString(rangeNoise); }},
+		"range noise sigma blurring the ISM's band: constant (sigmaConstant) or kinect (0.0012 + 0.0019 (d - 0.4)^2 m at depth d)",
+		R::oneOf({"constant", "kinect"}));
+	f.add("sigmaConstant", sigmaConstant, "range noise sigma of rangeNoise = constant [m]", R::positive());
+	f.add("logOddsMin", logOddsMin, "lower clamp of a cell's log-odds (< logit(pPrior))");
+	f.add("logOddsMax", logOddsMax, "upper clamp of a cell's log-odds (> logit(pPrior))");
+	f.add("maxRange", maxRange, "points farther than this from the camera, measured horizontally, are ignored [m]", R::positive());
+	f.add("obstacleMinHeight", obstacleMinHeight, "obstacle band above the floor, lower end [m] (> floorTolerance)");
+	f.add("obstacleMaxHeight", obstacleMaxHeight, "obstacle band, upper end [m] (> obstacleMinHeight); points above it are ignored");
+	f.add("floorTolerance", floorTolerance, "points within +- this of the floor are floor: their rays only clear space [m]", R::atLeast(0));
+	f.addCustom(
+		"T_world_floor",
+		{[this](const std::string& text) {
+			 mrpt::poses::CPose3D pose;
+			 try
+			 {
+				 pose.fromString(text);
+			 }
+			 catch (const std::exception&)
+			 {
+				 throw std::invalid_argument("expected \"[x y z yaw pitch roll]\" (m, deg)");
+			 }
+			 T_world_floor = pose;
+		 },
+		 [this] { return T_world_floor.asString(); }},
+		"floor frame (z up, z = 0 on the floor) in the world [x y z yaw pitch roll] (m, deg); keygrid-slam: use [floor]");
+	f.addCustom(
+		"estimateFloorFromDepth", detail::flagValue(estimateFloorFromDepth),
+		"estimate the floor by RANSAC from the first depth image instead of T_world_floor; keygrid-slam: use [floor]");
+	f.addCustom(
+		"floorUpHint", detail::vectorValue(floorUpHint), "\"up\" in the world (x y z) for that estimate; 0 0 0 = the camera's -y axis");
+	f.append(floorRansac.fields());
+	f.add("floorReanchorShift", floorReanchorShift,
+		  "keygrid-slam: a new floor estimate re-integrates the keyframes only if it moves a point of the grid by more than this [m] (0: always)",
+		  R::atLeast(0));
+	detail::addWords(
+		f, "freeSpaceModel", freeSpaceModel, {{"heightBand", FreeSpaceModel::HeightBand}, {"paper", FreeSpaceModel::Paper}},
+		"heightBand: rays clear only the band slices they cross, never obstacles above or below them; paper: all cells before a hit");
+	f.add("bandSliceHeight", bandSliceHeight, "heightBand: thickness of the obstacle band's height slices [m] (at most 64 slices)", R::positive());
+	detail::addWords(
+		f, "rayTraversal", rayTraversal, {{"bresenham", RayTraversal::Bresenham}, {"antialiased", RayTraversal::AntiAliased}},
+		"cells a ray updates: bresenham (one per step) or antialiased (Wu: two per step, weights summing to 1)");
+	f.add("depthDecimation", depthDecimation, "dense depth: use every n-th pixel in rows and columns", R::atLeast(1));
+	f.add("minPointsPerCell", minPointsPerCell, "dense depth: obstacle points an endpoint cell needs before it casts a ray (rejects speckle)", R::atLeast(1));
+	f.add("occupiedThreshold", occupiedThreshold, "a cell whose occupancy is >= this reads occupied (> pPrior)", R::between(0, 1));
+	f.add("freeThreshold", freeThreshold, "a cell whose occupancy is <= this reads free (< pPrior)", R::between(0, 1));
+	return f;
 }
 
-void CISMOccupancyGrid2D::TInsertionOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void CISMOccupancyGrid2D::TInsertionOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "pFree", pFree);
-	c.write(s, "pOccupied", pOccupied);
-	c.write(s, "pPrior", pPrior);
-	c.write(s, "bandWidth", bandWidth);
-	c.write(s, "rangeNoise", maps::toString(rangeNoise));
-	c.write(s, "sigmaConstant", sigmaConstant);
-	c.write(s, "logOddsMin", logOddsMin);
-	c.write(s, "logOddsMax", logOddsMax);
-	c.write(s, "maxRange", maxRange);
-	c.write(s, "obstacleMinHeight", obstacleMinHeight);
-	c.write(s, "obstacleMaxHeight", obstacleMaxHeight);
-	c.write(s, "floorTolerance", floorTolerance);
-	c.write(s, "T_world_floor", T_world_floor.asString());
-	c.write(s, "estimateFloorFromDepth", estimateFloorFromDepth);
-	c.write(s, "floorUpHint", std::to_string(floorUpHint.x) + " " + std::to_string(floorUpHint.y) + " " + std::to_string(floorUpHint.z));
-	floorRansac.saveToConfigFile(c, s);
-	c.write(s, "freeSpaceModel", freeSpaceModel == FreeSpaceModel::HeightBand ? "heightBand" : "paper");
-	c.write(s, "bandSliceHeight", bandSliceHeight);
-	c.write(s, "rayTraversal", rayTraversal == RayTraversal::Bresenham ? "bresenham" : "antialiased");
-	c.write(s, "depthDecimation", depthDecimation);
-	c.write(s, "minPointsPerCell", minPointsPerCell);
-	c.write(s, "occupiedThreshold", occupiedThreshold);
-	c.write(s, "freeThreshold", freeThreshold);
+	fields().read(c, s);
+	validate(s);
 }
 
-void CISMOccupancyGrid2D::TInsertionOptions::validate() const
+void CISMOccupancyGrid2D::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	const std::string s = "insertOpts";
-	try
-	{
-		ismShape(0.05).validate();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw std::invalid_argument(std::string("insertOpts: ") + e.what());
-	}
-	if (!(bandWidth >= 0)) badKey(s, "bandWidth", str(bandWidth), "must be >= 0");
-	if (!(sigmaConstant > 0)) badKey(s, "sigmaConstant", str(sigmaConstant), "must be > 0 m");
-	const double l0 = maps::logit(pPrior);
-	if (!(logOddsMin < l0)) badKey(s, "logOddsMin", str(logOddsMin), "must be below logit(pPrior) = " + str(l0));
-	if (!(logOddsMax > l0)) badKey(s, "logOddsMax", str(logOddsMax), "must be above logit(pPrior) = " + str(l0));
-	if (!(maxRange > 0)) badKey(s, "maxRange", str(maxRange), "must be > 0 m");
+	core::writeFields(*this, c, s);
+}
+
+void CISMOccupancyGrid2D::TInsertionOptions::validate(const std::string& s) const
+{
+	core::validateFields(*this, s);  // also the floorRansac_ keys
+	const std::string prior = "pPrior = " + std::to_string(pPrior);
+	if (!(pFree < pPrior)) badValue(s, "pFree", pFree, "< " + prior);
+	if (!(pOccupied > pPrior)) badValue(s, "pOccupied", pOccupied, "> " + prior);
+	const std::string l0 = "logit(pPrior) = " + std::to_string(maps::logit(pPrior));
+	if (!(logOddsMin < maps::logit(pPrior))) badValue(s, "logOddsMin", logOddsMin, "< " + l0);
+	if (!(logOddsMax > maps::logit(pPrior))) badValue(s, "logOddsMax", logOddsMax, "> " + l0);
 	if (!(obstacleMinHeight > floorTolerance))
-		badKey(s, "obstacleMinHeight", str(obstacleMinHeight), "must exceed floorTolerance = " + str(floorTolerance));
+		badValue(s, "obstacleMinHeight", obstacleMinHeight, "> floorTolerance = " + std::to_string(floorTolerance));
 	if (!(obstacleMaxHeight > obstacleMinHeight))
-		badKey(s, "obstacleMaxHeight", str(obstacleMaxHeight), "must exceed obstacleMinHeight");
-	if (!(floorTolerance >= 0)) badKey(s, "floorTolerance", str(floorTolerance), "must be >= 0 m");
-	if (!(bandSliceHeight > 0)) badKey(s, "bandSliceHeight", str(bandSliceHeight), "must be > 0 m");
+		badValue(s, "obstacleMaxHeight", obstacleMaxHeight, "> obstacleMinHeight = " + std::to_string(obstacleMinHeight));
 	if (!(std::ceil((obstacleMaxHeight - obstacleMinHeight) / bandSliceHeight - 1e-9) <= 64))
-		badKey(s, "bandSliceHeight", str(bandSliceHeight), "the obstacle band may have at most 64 height slices");
-	if (depthDecimation < 1) badKey(s, "depthDecimation", str(depthDecimation), "must be >= 1");
-	if (minPointsPerCell < 1) badKey(s, "minPointsPerCell", str(minPointsPerCell), "must be >= 1");
-	if (!(occupiedThreshold > pPrior && occupiedThreshold < 1))
-		badKey(s, "occupiedThreshold", str(occupiedThreshold), "must be in (pPrior, 1)");
-	if (!(freeThreshold > 0 && freeThreshold < pPrior))
-		badKey(s, "freeThreshold", str(freeThreshold), "must be in (0, pPrior)");
-	floorRansac.validate();
+		badValue(s, "bandSliceHeight", bandSliceHeight, "thick enough for at most 64 slices in the obstacle band");
+	if (!(occupiedThreshold > pPrior)) badValue(s, "occupiedThreshold", occupiedThreshold, "> " + prior);
+	if (!(freeThreshold < pPrior)) badValue(s, "freeThreshold", freeThreshold, "< " + prior);
 }
 
 // ------------------------------------------------------------------ likelihood
-void CISMOccupancyGrid2D::TLikelihoodOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields CISMOccupancyGrid2D::TLikelihoodOptions::fields()
 {
-	decimation = c.read_int(s, "decimation", decimation);
-	outlierProbability = c.read_double(s, "outlierProbability", outlierProbability);
-	try
-	{
-		validate();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		throw std::invalid_argument("[" + s + "] " + e.what());
-	}
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("decimation", decimation, "use every n-th depth pixel in rows and columns", R::atLeast(1));
+	f.add("outlierProbability", outlierProbability, "eps of each obstacle-band point's likelihood eps + (1 - eps) p(cell)", R::between(0, 1));
+	return f;
 }
 
-void CISMOccupancyGrid2D::TLikelihoodOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void CISMOccupancyGrid2D::TLikelihoodOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "decimation", decimation);
-	c.write(s, "outlierProbability", outlierProbability);
+	fields().read(c, s);
+	validate(s);
 }
 
-void CISMOccupancyGrid2D::TLikelihoodOptions::validate() const
+void CISMOccupancyGrid2D::TLikelihoodOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	if (decimation < 1) badKey("likelihoodOpts", "decimation", str(decimation), "must be >= 1");
-	if (!(outlierProbability > 0 && outlierProbability < 1))
-		badKey("likelihoodOpts", "outlierProbability", str(outlierProbability), "must be in (0, 1)");
+	core::writeFields(*this, c, s);
 }
+
+void CISMOccupancyGrid2D::TLikelihoodOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 }  // namespace keygrid

@@ -2,16 +2,16 @@
  * Construction, options, MRPT map definition, submap queries. Integration is in _insert.cpp,
  * morphing in _morph.cpp, serialization / exports / visualization in _io.cpp.
  */
-#include "detail/Grid3DConfig.h"
+#include "detail/OptionValues.h"
 
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
-
-#include <algorithm>
-#include <tuple>
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
+#include <tuple>
 
 using namespace keygrid;
 
@@ -24,13 +24,20 @@ MAP_DEFINITION_REGISTER(
 // ---------------------------------------------------------------- map definition (INI)
 CSubmappedOccupancyGrid3D::TMapDefinition::TMapDefinition() = default;
 
+core::OptionFields CSubmappedOccupancyGrid3D::TMapDefinition::creationFields()
+{
+	core::OptionFields f;
+	f.add("resolution", resolution, "voxel edge [m]", core::OptionRule::inRange(kMinResolution, kMaxResolution));
+	return f;
+}
+
 void CSubmappedOccupancyGrid3D::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& prefix)
 {
 	const std::string sCreation = prefix + "_creationOpts";
-	resolution = detail::readNumber(source, sCreation, "resolution", resolution);
-	detail::require(resolution >= kMinResolution && resolution <= kMaxResolution, sCreation + "/resolution", resolution,
-		"in [" + std::to_string(kMinResolution) + ", " + std::to_string(kMaxResolution) + "] m");
+	auto creation = creationFields();
+	creation.read(source, sCreation);
+	creation.validate(sCreation);
 	insertionOpts.loadFromConfigFile(source, prefix + "_insertOpts");
 	morphingOpts.loadFromConfigFile(source, prefix + "_insertOpts");
 	likelihoodOpts.loadFromConfigFile(source, prefix + "_likelihoodOpts");
@@ -56,45 +63,55 @@ mrpt::maps::CMetricMap* CSubmappedOccupancyGrid3D::internal_CreateFromMapDefinit
 }
 
 // ---------------------------------------------------------------- options
-void CSubmappedOccupancyGrid3D::TInsertionOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields CSubmappedOccupancyGrid3D::TInsertionOptions::fields()
 {
-	integration.loadFromConfigFile(c, s);
-	conflict.loadFromConfigFile(c, s);
-	storeKeyframeDepth = detail::readBool(c, s, "storeKeyframeDepth", storeKeyframeDepth);
-	observationsAreKeyframes =
-		detail::readBool(c, s, "observationsAreKeyframes", observationsAreKeyframes);
+	core::OptionFields f;
+	f.append(integration.fields());
+	f.append(conflict.fields());
+	f.addCustom("storeKeyframeDepth", detail::flagValue(storeKeyframeDepth), "keep each keyframe's depth image (1.2 MB at 640x480) to re-integrate it at corrected poses");
+	f.addCustom("observationsAreKeyframes", detail::flagValue(observationsAreKeyframes), "insertObservation(): record every observation as a keyframe (false: only update the grid)");
+	return f;
 }
 
-void CSubmappedOccupancyGrid3D::TInsertionOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void CSubmappedOccupancyGrid3D::TInsertionOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	integration.saveToConfigFile(c, s);
-	conflict.saveToConfigFile(c, s);
-	detail::writeBool(c, s, "storeKeyframeDepth", storeKeyframeDepth);
-	detail::writeBool(c, s, "observationsAreKeyframes", observationsAreKeyframes);
+	fields().read(c, s);
+	validate(s);
 }
 
-void CSubmappedOccupancyGrid3D::TLikelihoodOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+void CSubmappedOccupancyGrid3D::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	const double d = detail::readNumber(c, s, "decimation", decimation);
-	detail::require(d >= 1 && d == std::floor(d), "decimation", d, "an integer >= 1");
-	decimation = static_cast<unsigned>(d);
-	maxRange = detail::readNumber(c, s, "maxRange", maxRange);
-	detail::require(maxRange > 0, "maxRange", maxRange, "> 0 m");
-	minProbability = detail::readNumber(c, s, "minProbability", minProbability);
-	detail::require(minProbability > 0 && minProbability < 0.5, "minProbability", minProbability,
-		"in (0, 0.5)");
+	core::writeFields(*this, c, s);
 }
 
-void CSubmappedOccupancyGrid3D::TLikelihoodOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void CSubmappedOccupancyGrid3D::TInsertionOptions::validate(const std::string& s) const
 {
-	detail::writeNumber(c, s, "decimation", decimation);
-	detail::writeNumber(c, s, "maxRange", maxRange);
-	detail::writeNumber(c, s, "minProbability", minProbability);
+	integration.validate(s);
+	conflict.validate(s);  // the two flags take any value
 }
+
+core::OptionFields CSubmappedOccupancyGrid3D::TLikelihoodOptions::fields()
+{
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("decimation", decimation, "use every n-th depth pixel in rows and columns", R::atLeast(1));
+	f.add("maxRange", maxRange, "pixels farther than this from the camera centre are left out [m]", R::positive());
+	f.add("minProbability", minProbability, "floor of each pixel's occupancy probability (unknown voxels: 0.5)", R::between(0, 0.5));
+	return f;
+}
+
+void CSubmappedOccupancyGrid3D::TLikelihoodOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+{
+	fields().read(c, s);
+	validate(s);
+}
+
+void CSubmappedOccupancyGrid3D::TLikelihoodOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+{
+	core::writeFields(*this, c, s);
+}
+
+void CSubmappedOccupancyGrid3D::TLikelihoodOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 // ---------------------------------------------------------------- basics
 CSubmappedOccupancyGrid3D::CSubmappedOccupancyGrid3D(double resolution)
@@ -104,8 +121,10 @@ CSubmappedOccupancyGrid3D::CSubmappedOccupancyGrid3D(double resolution)
 
 void CSubmappedOccupancyGrid3D::setResolution(double resolution)
 {
-	detail::require(resolution >= kMinResolution && resolution <= kMaxResolution, "resolution", resolution,
-		"in [" + std::to_string(kMinResolution) + ", " + std::to_string(kMaxResolution) + "] m");
+	if (!(resolution >= kMinResolution && resolution <= kMaxResolution))
+		throw std::invalid_argument(
+			"CSubmappedOccupancyGrid3D: resolution = " + std::to_string(resolution) + " (must be in [" + std::to_string(kMinResolution) +
+			", " + std::to_string(kMaxResolution) + "] m)");
 	m_resolution = resolution;
 	internal_clear();
 }

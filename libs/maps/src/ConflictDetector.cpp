@@ -1,5 +1,5 @@
-#include "detail/Grid3DConfig.h"
 #include "detail/Grid3DParallel.h"
+#include "detail/OptionValues.h"
 
 #include <keygrid/maps/ConflictDetector.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -8,60 +8,30 @@
 
 namespace keygrid
 {
-void ConflictOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields ConflictOptions::fields()
 {
-	using detail::readNumber;
-	travelledDistanceThreshold =
-		readNumber(c, s, "travelledDistanceThreshold", travelledDistanceThreshold);
-	occupiedConfidentLogOdds =
-		static_cast<float>(readNumber(c, s, "occupiedConfidentLogOdds", occupiedConfidentLogOdds));
-	freeConfidentLogOdds =
-		static_cast<float>(readNumber(c, s, "freeConfidentLogOdds", freeConfidentLogOdds));
-	conflictMinVoxels = readNumber(c, s, "conflictMinVoxels", conflictMinVoxels);
-	conflictMinFraction = readNumber(c, s, "conflictMinFraction", conflictMinFraction);
-	localizationEnterHitFraction =
-		readNumber(c, s, "localizationEnterHitFraction", localizationEnterHitFraction);
-	localizationExitHitFraction =
-		readNumber(c, s, "localizationExitHitFraction", localizationExitHitFraction);
-	localizationMaxContradictionFraction = readNumber(
-		c, s, "localizationMaxContradictionFraction", localizationMaxContradictionFraction);
-	validate();
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("travelledDistanceThreshold", travelledDistanceThreshold, "a known voxel is stale when the camera travelled more than this since it was last updated [m]", R::positive());
+	f.add("occupiedConfidentLogOdds", occupiedConfidentLogOdds, "a voxel with log-odds >= this is confidently occupied (a miss contradicts it)", R::positive());
+	f.add("freeConfidentLogOdds", freeConfidentLogOdds, "a voxel with log-odds <= this is confidently free (a hit contradicts it)", detail::negative());
+	f.add("conflictMinVoxels", conflictMinVoxels, "exploration: stale contradicted voxels of a frame that open a new submap [voxels] ...", R::atLeast(1));
+	f.add("conflictMinFraction", conflictMinFraction, "... and their least share of the frame's hit voxels", R::inRange(0, 1));
+	f.add("localizationEnterHitFraction", localizationEnterHitFraction, "share of a frame's hits on stale occupied voxels (a revisit) that enters localization", R::aboveUpTo(0, 1));
+	f.add("localizationExitHitFraction", localizationExitHitFraction, "localization ends when the share of hits on occupied voxels falls below this", R::inRange(0, 1));
+	f.add("localizationMaxContradictionFraction", localizationMaxContradictionFraction, "a revisit enters localization only with at most this share of stale contradictions (of the hits)", R::inRange(0, 1));
+	return f;
 }
 
-void ConflictOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void ConflictOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	detail::writeNumber(c, s, "travelledDistanceThreshold", travelledDistanceThreshold);
-	detail::writeNumber(c, s, "occupiedConfidentLogOdds", occupiedConfidentLogOdds);
-	detail::writeNumber(c, s, "freeConfidentLogOdds", freeConfidentLogOdds);
-	detail::writeNumber(c, s, "conflictMinVoxels", conflictMinVoxels);
-	detail::writeNumber(c, s, "conflictMinFraction", conflictMinFraction);
-	detail::writeNumber(c, s, "localizationEnterHitFraction", localizationEnterHitFraction);
-	detail::writeNumber(c, s, "localizationExitHitFraction", localizationExitHitFraction);
-	detail::writeNumber(c, s, "localizationMaxContradictionFraction", localizationMaxContradictionFraction);
+	fields().read(c, s);
+	validate(s);
 }
 
-void ConflictOptions::validate() const
-{
-	using detail::require;
-	require(travelledDistanceThreshold > 0, "travelledDistanceThreshold",
-		travelledDistanceThreshold, "> 0 m");
-	require(occupiedConfidentLogOdds > 0, "occupiedConfidentLogOdds", occupiedConfidentLogOdds,
-		"> 0");
-	require(freeConfidentLogOdds < 0, "freeConfidentLogOdds", freeConfidentLogOdds, "< 0");
-	require(conflictMinVoxels >= 1, "conflictMinVoxels", conflictMinVoxels, ">= 1");
-	require(conflictMinFraction >= 0 && conflictMinFraction <= 1, "conflictMinFraction",
-		conflictMinFraction, "in [0, 1]");
-	require(localizationEnterHitFraction > 0 && localizationEnterHitFraction <= 1,
-		"localizationEnterHitFraction", localizationEnterHitFraction, "in (0, 1]");
-	require(localizationExitHitFraction >= 0 && localizationExitHitFraction <= 1,
-		"localizationExitHitFraction", localizationExitHitFraction, "in [0, 1]");
-	require(localizationMaxContradictionFraction >= 0 &&
-			localizationMaxContradictionFraction <= 1,
-		"localizationMaxContradictionFraction", localizationMaxContradictionFraction,
-		"in [0, 1]");
-}
+void ConflictOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
+
+void ConflictOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 FrameEvidence evaluateFrame(
 	const VoxelBlockGrid& grid, const FrameVoxelUpdates& upd, double travelled,

@@ -1,5 +1,5 @@
-#include "detail/Grid3DConfig.h"
 #include "detail/Grid3DParallel.h"
+#include "detail/OptionValues.h"
 
 #include <keygrid/maps/Dda.h>
 #include <keygrid/maps/DepthFrameIntegrator.h>
@@ -19,54 +19,47 @@
 namespace keygrid
 {
 // ---------------------------------------------------------------- options
-void DepthIntegrationOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields DepthIntegrationOptions::fields()
 {
-	using detail::readNumber;
-	maxRange = readNumber(c, s, "maxRange", maxRange);
-	minRange = readNumber(c, s, "minRange", minRange);
-	const double dec = readNumber(c, s, "pixelDecimation", pixelDecimation);
-	detail::require(dec >= 1 && dec == std::floor(dec), "pixelDecimation", dec, "an integer >= 1");
-	pixelDecimation = static_cast<unsigned>(dec);
-	const double th = readNumber(c, s, "threads", threads);
-	detail::require(th >= 0 && th == std::floor(th), "threads", th, "an integer >= 0");
-	threads = static_cast<unsigned>(th);
-	logOddsHit = static_cast<float>(readNumber(c, s, "logOddsHit", logOddsHit));
-	logOddsMiss = static_cast<float>(readNumber(c, s, "logOddsMiss", logOddsMiss));
-	logOddsMin = static_cast<float>(readNumber(c, s, "logOddsMin", logOddsMin));
-	logOddsMax = static_cast<float>(readNumber(c, s, "logOddsMax", logOddsMax));
-	maxDenseMarkVoxels = readNumber(c, s, "maxDenseMarkVoxels", maxDenseMarkVoxels);
-	discretizeEndpoints = detail::readBool(c, s, "discretizeEndpoints", discretizeEndpoints);
-	validate();
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("maxRange", maxRange, "rays are cut at this distance from the camera centre: free space up to it, no hit [m]", R::positive());
+	f.add("minRange", minRange, "pixels nearer than this to the camera centre are ignored [m] (< maxRange)", R::atLeast(0));
+	f.add("pixelDecimation", pixelDecimation, "use every n-th pixel in rows and columns", R::atLeast(1));
+	f.add("threads", threads, "integration worker threads, 0 = all hardware threads (same result for any count)");
+	f.add("logOddsHit", logOddsHit, "log-odds added to the voxel a ray ends in", R::positive());
+	f.add("logOddsMiss", logOddsMiss, "log-odds added to the voxels a ray crosses before its end", detail::negative());
+	f.add("logOddsMin", logOddsMin, "lower clamp of a voxel's log-odds", detail::negative());
+	f.add("logOddsMax", logOddsMax, "upper clamp of a voxel's log-odds", R::positive());
+	f.addCustom(
+		"maxDenseMarkVoxels", detail::exactNumberValue(maxDenseMarkVoxels),
+		"largest dense per-frame mark volume [voxels, 1 byte each] in [512, 1073741824]; larger frames take a slower sparse path");
+	f.addCustom(
+		"discretizeEndpoints", detail::flagValue(discretizeEndpoints),
+		"one free-space ray per distinct end voxel (to its centre) instead of one per pixel, as OctoMap's discretize");
+	return f;
 }
 
-void DepthIntegrationOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void DepthIntegrationOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	detail::writeNumber(c, s, "maxRange", maxRange);
-	detail::writeNumber(c, s, "minRange", minRange);
-	detail::writeNumber(c, s, "pixelDecimation", pixelDecimation);
-	detail::writeNumber(c, s, "threads", threads);
-	detail::writeNumber(c, s, "logOddsHit", logOddsHit);
-	detail::writeNumber(c, s, "logOddsMiss", logOddsMiss);
-	detail::writeNumber(c, s, "logOddsMin", logOddsMin);
-	detail::writeNumber(c, s, "logOddsMax", logOddsMax);
-	detail::writeNumber(c, s, "maxDenseMarkVoxels", maxDenseMarkVoxels);
-	detail::writeBool(c, s, "discretizeEndpoints", discretizeEndpoints);
+	fields().read(c, s);
+	validate(s);
 }
 
-void DepthIntegrationOptions::validate() const
+void DepthIntegrationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	using detail::require;
-	require(maxRange > 0, "maxRange", maxRange, "> 0 m");
-	require(minRange >= 0 && minRange < maxRange, "minRange", minRange, ">= 0 and < maxRange");
-	require(pixelDecimation >= 1, "pixelDecimation", pixelDecimation, ">= 1");
-	require(logOddsHit > 0, "logOddsHit", logOddsHit, "> 0");
-	require(logOddsMiss < 0, "logOddsMiss", logOddsMiss, "< 0");
-	require(logOddsMin < 0, "logOddsMin", logOddsMin, "< 0");
-	require(logOddsMax > 0, "logOddsMax", logOddsMax, "> 0");
-	require(maxDenseMarkVoxels >= 512 && maxDenseMarkVoxels <= 1073741824.0, "maxDenseMarkVoxels", maxDenseMarkVoxels,
-		"in [512, 1073741824] (one byte per voxel)");
+	core::writeFields(*this, c, s);
+}
+
+void DepthIntegrationOptions::validate(const std::string& s) const
+{
+	core::validateFields(*this, s);
+	if (!(minRange < maxRange))
+		throw std::invalid_argument(
+			"[" + s + "] minRange = " + std::to_string(minRange) + " (must be < maxRange = " + std::to_string(maxRange) + ")");
+	if (!(maxDenseMarkVoxels >= 512 && maxDenseMarkVoxels <= 1073741824.0))
+		throw std::invalid_argument(
+			"[" + s + "] maxDenseMarkVoxels = " + std::to_string(maxDenseMarkVoxels) + " (must be in [512, 1073741824], one byte per voxel)");
 }
 
 // ---------------------------------------------------------------- ray table

@@ -1,6 +1,8 @@
 /** \file FloorFrameEstimator.cpp
  * The run's floor frame: options, the lowest-plane search and the pooled estimator.
  */
+#include "detail/OptionValues.h"
+
 #include <keygrid/core/PinholeIntrinsics.h>
 #include <keygrid/maps/FloorFrameEstimator.h>
 #include <mrpt/math/CQuaternion.h>
@@ -31,19 +33,7 @@ core::OptionFields FloorFrameOptions::fields()
 		 [this] { return givenPose.empty() ? std::string("estimate") : givenPose; }},
 		"estimate, or the floor frame given as [x y z yaw pitch roll] (m, deg) in the SLAM world");
 	f.addCustom(
-		"up_hint",
-		{[this](const std::string& text) {
-			 std::istringstream is(text);
-			 double x = 0, y = 0, z = 0;
-			 if (!(is >> x >> y >> z) || !(is >> std::ws).eof()) throw std::invalid_argument("expected three numbers \"x y z\"");
-			 upHint = TVector3D(x, y, z);
-		 },
-		 [this] {
-			 char up[96];
-			 std::snprintf(up, sizeof(up), "%g %g %g", upHint.x, upHint.y, upHint.z);
-			 return std::string(up);
-		 }},
-		"\"up\" in the SLAM world for the first search; 0 0 0 = mean -y of the keyframe cameras");
+		"up_hint", detail::vectorValue(upHint), "\"up\" in the SLAM world for the first search; 0 0 0 = mean -y of the keyframe cameras");
 	f.add("initial_keyframes", initialKeyframes, "estimate at every keyframe until this many contributed (and the floor is found)", R::atLeast(1));
 	f.add("reestimate_every", reestimateEvery, "then re-estimate every N keyframes and after trajectory corrections", R::atLeast(1));
 	f.add("reservoir_size", reservoirSize, "depth samples kept (uniform over all keyframes)", R::atLeast(100));

@@ -10,41 +10,31 @@
 
 namespace keygrid::maps
 {
-void FloorPlaneRansacOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields FloorPlaneRansacOptions::fields()
 {
-	inlierDistance = c.read_double(s, "floorRansac_inlierDistance", inlierDistance);
-	iterations = c.read_int(s, "floorRansac_iterations", iterations);
-	maxTiltDeg = c.read_double(s, "floorRansac_maxTiltDeg", maxTiltDeg);
-	minInlierFraction = c.read_double(s, "floorRansac_minInlierFraction", minInlierFraction);
-	minCameraHeight = c.read_double(s, "floorRansac_minCameraHeight", minCameraHeight);
-	seed = static_cast<uint32_t>(c.read_uint64_t(s, "floorRansac_seed", seed));
-	validate();
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("floorRansac_inlierDistance", inlierDistance, "floor RANSAC: point-to-plane distance of an inlier [m]", R::positive());
+	f.add("floorRansac_iterations", iterations, "floor RANSAC: least hypotheses per plane (more when floorRansac_minInlierFraction needs them)", R::atLeast(1));
+	f.add("floorRansac_maxTiltDeg", maxTiltDeg, "floor RANSAC: largest angle between the plane normal and the up hint [deg]", R::between(0, 90));
+	f.add("floorRansac_minInlierFraction", minInlierFraction, "floor RANSAC: least share of all points on a plane for it to count", R::aboveUpTo(0, 1));
+	f.add("floorRansac_minCameraHeight", minCameraHeight, "floor RANSAC: the camera is at least this high above the floor [m]", R::atLeast(0));
+	f.add("floorRansac_seed", seed, "floor RANSAC: random seed of the sampling (the same seed gives the same floor)");
+	return f;
 }
 
-void FloorPlaneRansacOptions::saveToConfigFile(
-	mrpt::config::CConfigFileBase& c, const std::string& s) const
+void FloorPlaneRansacOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "floorRansac_inlierDistance", inlierDistance);
-	c.write(s, "floorRansac_iterations", iterations);
-	c.write(s, "floorRansac_maxTiltDeg", maxTiltDeg);
-	c.write(s, "floorRansac_minInlierFraction", minInlierFraction);
-	c.write(s, "floorRansac_minCameraHeight", minCameraHeight);
-	c.write(s, "floorRansac_seed", static_cast<uint64_t>(seed));
+	fields().read(c, s);
+	validate(s);
 }
 
-void FloorPlaneRansacOptions::validate() const
+void FloorPlaneRansacOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
-	auto bad = [](const std::string& key, double v) {
-		throw std::invalid_argument(
-			"invalid value " + std::to_string(v) + " for key 'floorRansac_" + key + "'");
-	};
-	if (!(inlierDistance > 0)) bad("inlierDistance", inlierDistance);
-	if (iterations < 1) bad("iterations", iterations);
-	if (!(maxTiltDeg > 0 && maxTiltDeg < 90)) bad("maxTiltDeg", maxTiltDeg);
-	if (!(minInlierFraction > 0 && minInlierFraction <= 1)) bad("minInlierFraction", minInlierFraction);
-	if (!(minCameraHeight >= 0)) bad("minCameraHeight", minCameraHeight);
+	core::writeFields(*this, c, s);
 }
+
+void FloorPlaneRansacOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 namespace
 {

@@ -1,5 +1,5 @@
-#include "detail/Grid3DConfig.h"
 #include "detail/GridMorphingDetail.h"
+#include "detail/OptionValues.h"
 
 #include <keygrid/maps/GridMorphing.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -16,51 +16,32 @@
 
 namespace keygrid
 {
-void MorphingOptions::loadFromConfigFile(
-	const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields MorphingOptions::fields()
 {
-	using detail::readNumber;
-	viewConeMaxRange = readNumber(c, s, "morphViewConeMaxRange", viewConeMaxRange);
-	travelWindow = readNumber(c, s, "morphTravelWindow", travelWindow);
-	weightExponent = readNumber(c, s, "morphWeightExponent", weightExponent);
-	minWeightDistance = readNumber(c, s, "morphMinWeightDistance", minWeightDistance);
-	keepVoxelsOutsideCones = detail::readBool(c, s, "morphKeepVoxelsOutsideCones", keepVoxelsOutsideCones);
-	const double kmax = readNumber(c, s, "morphMaxKeyframesPerBlock", maxKeyframesPerBlock);
-	detail::require(kmax >= 0 && kmax == std::floor(kmax) && kmax <= 1e6, "morphMaxKeyframesPerBlock",
-		kmax, "an integer in [0, 1000000]");
-	maxKeyframesPerBlock = static_cast<unsigned>(kmax);
-	const double th = readNumber(c, s, "morphThreads", threads);
-	detail::require(th >= 0 && th == std::floor(th), "morphThreads", th, "an integer >= 0");
-	threads = static_cast<unsigned>(th);
-	const std::string interp = c.read_string(s, "morphInterpolation", "", false);
-	if (interp == "nearest") interpolation = Interpolation::Nearest;
-	else if (interp == "trilinear") interpolation = Interpolation::Trilinear;
-	else if (!interp.empty())
-		throw std::invalid_argument(
-			"[" + s + "] morphInterpolation = '" + interp + "' (expected nearest or trilinear)");
-	validate();
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("morphViewConeMaxRange", viewConeMaxRange, "morphing: depth of each keyframe's view cone [m]", R::positive());
+	f.add("morphTravelWindow", travelWindow, "morphing: a lookup through a keyframe counts only for voxels updated within this travel of it [m], 0 = off", R::atLeast(0));
+	f.add("morphWeightExponent", weightExponent, "morphing: exponent p of a keyframe's weight 1 / max(z, morphMinWeightDistance)^p, z = distance to its camera", R::atLeast(0));
+	f.add("morphMinWeightDistance", minWeightDistance, "morphing: distances below this count as this in the weights [m]", R::positive());
+	f.addCustom("morphKeepVoxelsOutsideCones", detail::flagValue(keepVoxelsOutsideCones), "morphing: voxels no view cone gives a value move with their last updater's correction (false: dropped)");
+	f.add("morphMaxKeyframesPerBlock", maxKeyframesPerBlock, "morphing: at most this many keyframes per 8^3 block (an approximation), 0 = all", R::inRange(0, 1000000));
+	f.add("morphThreads", threads, "morphing worker threads, 0 = all hardware threads (same result for any count)");
+	detail::addWords(
+		f, "morphInterpolation", interpolation, {{"nearest", Interpolation::Nearest}, {"trilinear", Interpolation::Trilinear}},
+		"morphing: how a keyframe reads a voxel at its earlier position: nearest voxel, or trilinear over the 8 around it");
+	return f;
 }
 
-void MorphingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void MorphingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	detail::writeNumber(c, s, "morphViewConeMaxRange", viewConeMaxRange);
-	detail::writeNumber(c, s, "morphTravelWindow", travelWindow);
-	detail::writeNumber(c, s, "morphWeightExponent", weightExponent);
-	detail::writeNumber(c, s, "morphMinWeightDistance", minWeightDistance);
-	detail::writeBool(c, s, "morphKeepVoxelsOutsideCones", keepVoxelsOutsideCones);
-	detail::writeNumber(c, s, "morphMaxKeyframesPerBlock", maxKeyframesPerBlock);
-	detail::writeNumber(c, s, "morphThreads", threads);
-	c.write(s, "morphInterpolation",
-		std::string(interpolation == Interpolation::Nearest ? "nearest" : "trilinear"));
+	fields().read(c, s);
+	validate(s);
 }
 
-void MorphingOptions::validate() const
-{
-	detail::require(viewConeMaxRange > 0, "morphViewConeMaxRange", viewConeMaxRange, "> 0 m");
-	detail::require(weightExponent >= 0, "morphWeightExponent", weightExponent, ">= 0");
-	detail::require(travelWindow >= 0, "morphTravelWindow", travelWindow, ">= 0 m");
-	detail::require(minWeightDistance > 0, "morphMinWeightDistance", minWeightDistance, "> 0 m");
-}
+void MorphingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
+
+void MorphingOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 using namespace detail::morphing;
 

@@ -138,7 +138,8 @@ bool saveKnownMapDefinition(const mrpt::maps::TMetricMapInitializer& def, const 
 	if (const auto* d = dynamic_cast<const CSubmappedOccupancyGrid3D::TMapDefinition*>(&def))
 	{
 		d->genericMapParams.saveToConfigFile(rec, creation);
-		rec.write(creation, "resolution", d->resolution, 0, 0, "voxel edge [m]");
+		auto copy = *d;  // the table points into the definition it is built on
+		copy.creationFields().write(rec, creation);
 		d->insertionOpts.saveToConfigFile(rec, insert);
 		d->morphingOpts.saveToConfigFile(rec, insert);
 		d->likelihoodOpts.saveToConfigFile(rec, likelihood);

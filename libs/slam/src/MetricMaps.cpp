@@ -239,10 +239,13 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 	std::map<std::string, double> out;
 	maps::MapCorrection correction;
 	{
-		// The floor under the corrected poses; the maps in it are re-anchored below anyway.
+		// The floor under the corrected poses. The maps are re-anchored below anyway, so they
+		// take the newest floor frame even when it did not change now (a 2D grid may have kept
+		// an older one, see floorReanchorShift).
 		const auto t0 = std::chrono::steady_clock::now();
 		std::map<uint64_t, mrpt::poses::CPose3D> np(newPoses.begin(), newPoses.end());
-		if (m_floor.updatePoses(np)) correction.T_world_floor = m_floor.T_world_floor();
+		m_floor.updatePoses(np);
+		correction.T_world_floor = m_floor.T_world_floor();
 		out["floor"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}
 	for (const auto& [id, T] : newPoses)

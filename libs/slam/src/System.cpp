@@ -500,8 +500,11 @@ std::map<std::string, double> System::reanchorMaps(const std::map<sfm::KeyFrameI
 		mrpt::poses::CPose3D T;
 		if (m_map.poseOf(id, T)) poses[id] = T;
 	}
-	if (largestDisplacement(before, poses, rc.mapReanchorDepth) > rc.mapReanchorMinShift)
-		seconds = publishCorrection({PoseCorrection::Source::FinalRefinement, poses, 0}, nullptr);
+	FinalMapShift shift;
+	shift.largest = largestDisplacement(before, poses, rc.mapReanchorDepth);
+	shift.reanchored = shift.largest > rc.mapReanchorMinShift;
+	m_finalMapShift = shift;
+	if (shift.reanchored) seconds = publishCorrection({PoseCorrection::Source::FinalRefinement, poses, 0}, nullptr);
 	m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 	return seconds;
 }

@@ -138,6 +138,8 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	if (const auto& ba = sys.globalBundleAdjustmentReport())
 		js["global_ba"] = {{"keyframes", ba->keyframes},		{"landmarks", ba->landmarks}, {"landmarks_left_out", ba->landmarksLeftOut}, {"observations", ba->observations},
 						   {"outliers", ba->outliersRemoved}, {"iterations", ba->iterations}, {"median_chi2", rounded(ba->medianChi2, 4)}};
+	if (const auto& shift = sys.finalMapShift())
+		js["final_map_shift"] = {{"largest_m", rounded(shift->largest, 5)}, {"reanchored", shift->reanchored}};
 	js["fps"] = rounded(in.result.fps, 3);
 	js["wall_time_s"] = rounded(in.wallSeconds, 3);
 	js["timings"] = parsed(sys.timings().toJson(2));

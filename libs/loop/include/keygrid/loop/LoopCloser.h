@@ -7,6 +7,7 @@
  * keyframe pose graph; after optimisation landmarks follow their keyframes and the duplicated
  * landmarks around the loop are fused.
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/loop/ConsistencyChecker.h>
 #include <keygrid/loop/KeyFrameDatabase.h>
 #include <keygrid/loop/PoseGraph.h>
@@ -60,6 +61,8 @@ struct LoopClosingOptions
 	int covisibilityEdgeMinWeight{100};
 	PoseGraphOptions poseGraph;
 
+	/** The INI keys, with description and rule. */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 

@@ -72,7 +72,8 @@ struct PoseCorrection
 	Eigen::Isometry3d T_world_kf_new{Eigen::Isometry3d::Identity()};
 };
 
-struct PoseGraphSummary
+/** How the solver went (PoseGraph and Sim3PoseGraph). */
+struct PoseGraphSolverReport
 {
 	bool usable{false};  //!< the solver returned a usable solution
 	double initialCost{0}, finalCost{0};  //!< Ceres cost 0.5 sum rho(|r|^2)
@@ -80,6 +81,10 @@ struct PoseGraphSummary
 	double seconds{0};
 	std::string linearSolver;  //!< e.g. "SPARSE_NORMAL_CHOLESKY (SUITE_SPARSE)"
 	std::string message;
+};
+
+struct PoseGraphSummary : PoseGraphSolverReport
+{
 	std::vector<PoseCorrection> corrections;  //!< every vertex, old and new pose
 };
 

@@ -3,6 +3,7 @@
  * A 2D navigation occupancy grid filled from visual-SLAM keyframes with the erf inverse sensor
  * model of Lu & Wang (2018). MRPT CMetricMap plugin registered as "ismOccupancyGrid2D".
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/maps/FloorPlaneEstimator.h>
 #include <keygrid/maps/InverseSensorModel.h>
 #include <keygrid/maps/KeyFrameMap.h>
@@ -74,12 +75,14 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 		/** Extra border added when the grid has to grow [m] (Default: 2 m) */
 		double growthMargin{2.0};
 
+		/** The INI keys (MRPT's COccupancyGridMap2D names), with description and rule. */
+		core::OptionFields fields();
 		void loadFromConfigFile(
 			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(
 			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
-		/** Throws std::invalid_argument naming the key on a bad value. */
-		void validate() const;
+		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
+		void validate(const std::string& section = "creationOpts") const;
 	};
 
 	/** Ray traversal used to distribute the ISM over cells. */
@@ -138,6 +141,11 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 		mrpt::math::TVector3D floorUpHint{0, 0, 0};
 		/** RANSAC parameters of that estimate */
 		maps::FloorPlaneRansacOptions floorRansac;
+		/** A new external floor frame (setFloorFrame()) re-integrates the keyframes only when
+		 * it moves some point of the grid's box (its extent, from -floorTolerance to
+		 * obstacleMaxHeight) by more than this [m]; a smaller change keeps the floor frame the
+		 * cells were built in. 0: every change re-integrates (Default: 0.01 m) */
+		double floorReanchorShift{0.01};
 		/** Free-space model: "heightBand" or "paper" (Default: heightBand) */
 		FreeSpaceModel freeSpaceModel{FreeSpaceModel::HeightBand};
 		/** heightBand: thickness of the height slices of the obstacle band [m] (Default: 0.05 m) */
@@ -157,12 +165,14 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 		/** The ISM shape these options define at a given resolution (L = 0 -> diagonal). */
 		maps::IsmShape ismShape(double resolution) const;
 
+		/** The INI keys (floorRansac's prefixed "floorRansac_"), with description and rule. */
+		core::OptionFields fields();
 		void loadFromConfigFile(
 			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(
 			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
-		/** Throws std::invalid_argument naming the key on a bad value. */
-		void validate() const;
+		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
+		void validate(const std::string& section = "insertOpts") const;
 	};
 
 	/** Likelihood options for computeObservationLikelihood(CObservation3DRangeScan). */
@@ -173,11 +183,13 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 		/** Probability floor mixed into each point's cell occupancy (Default: 0.05) */
 		double outlierProbability{0.05};
 
+		core::OptionFields fields();
 		void loadFromConfigFile(
 			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(
 			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
-		void validate() const;
+		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
+		void validate(const std::string& section = "likelihoodOpts") const;
 	};
 
 	/** One keyframe's stored rays: camera pose and ray endpoints in the optical frame. */
@@ -218,6 +230,10 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	double applyTrajectoryCorrection(const std::map<uint64_t, mrpt::poses::CPose3D>& newPoses);
 	double lastRebuildSeconds() const { return m_lastRebuildSeconds; }
 	const std::map<uint64_t, KeyframeRays>& keyframes() const { return m_keyframes; }
+	/** Largest move of a point of the grid's box (extent x [-floorTolerance,
+	 * obstacleMaxHeight] in the floor frame) when the floor frame changes to T_world_floor:
+	 * the distance between its coordinates in the two frames [m]. */
+	double floorFrameShift(const mrpt::poses::CPose3D& T_world_floor) const;
 	/** Sets the floor frame from a plane estimate on given world points (e.g. SLAM map points).
 	 * The "up" hint is insertionOptions.floorUpHint, else `upHint` when given (e.g. the mean -y
 	 * of several cameras), else -y of the camera; the floor frame's origin is the camera
@@ -260,7 +276,8 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	void notifyLoopClosure() override {}
 	/** The run's floor frame becomes the grid's (setExternalFloorPose(); nullopt:
 	 * expectExternalFloorPose()) and the keyframes integrated so far are integrated again in
-	 * it. The first call refuses a floor of the grid's own (insertionOptions.T_world_floor
+	 * it, unless it moves no point of the grid by more than floorReanchorShift (see
+	 * floorFrameShift()): the grid then keeps its floor frame. The first call refuses a floor of the grid's own (insertionOptions.T_world_floor
 	 * without estimateFloorFromDepth), naming the INI key. */
 	void setFloorFrame(const std::optional<mrpt::poses::CPose3D>& T_world_floor) override;
 	/** map_2d<suffix>.yaml + .pgm (saveAsRosMapServer), .png (saveAsImage) and .bin (this map

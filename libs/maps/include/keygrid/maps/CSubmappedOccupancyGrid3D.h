@@ -97,10 +97,14 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 		/** Record every observation passed to insertObservation() as a keyframe (Default: true) */
 		bool observationsAreKeyframes{true};
 
+		/** The INI keys of integration, conflict and this struct, with description and rule. */
+		core::OptionFields fields();
 		void loadFromConfigFile(
 			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(
 			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
+		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
+		void validate(const std::string& section = "insertOpts") const;
 	};
 
 	/** Options of computeObservationLikelihood (INI section `..._likelihoodOpts`). */
@@ -113,10 +117,13 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 		/** Floor of the per-point occupancy probability (Default: 0.05) */
 		double minProbability{0.05};
 
+		core::OptionFields fields();
 		void loadFromConfigFile(
 			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
 		void saveToConfigFile(
 			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
+		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
+		void validate(const std::string& section = "likelihoodOpts") const;
 	};
 
 	TInsertionOptions insertionOptions;
@@ -280,6 +287,8 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	MAP_DEFINITION_START(CSubmappedOccupancyGrid3D)
 	/** Voxel edge [m] (Default: 0.05 m); INI section `_creationOpts`, key `resolution` */
 	double resolution{0.05};
+	/** The `_creationOpts` keys (resolution), with description and rule. */
+	core::OptionFields creationFields();
 	keygrid::CSubmappedOccupancyGrid3D::TInsertionOptions insertionOpts;
 	keygrid::MorphingOptions morphingOpts;
 	keygrid::CSubmappedOccupancyGrid3D::TLikelihoodOptions likelihoodOpts;

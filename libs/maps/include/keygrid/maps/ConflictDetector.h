@@ -24,6 +24,7 @@
  *   conflict                     : only in Exploration, when the stale contradictions reach both
  *                                  conflictMinVoxels and conflictMinFraction of the frame's hit voxels.
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/maps/DepthFrameIntegrator.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
 
@@ -61,10 +62,12 @@ struct ConflictOptions
 	 * revisit when entering localization from occupancy alone (Default: 0.02) */
 	double localizationMaxContradictionFraction{0.02};
 
+	/** The INI keys, with description and rule. */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
-	/** Throws std::invalid_argument naming the key and value of the first bad field. */
-	void validate() const;
+	/** Throws std::invalid_argument naming [section], key and value of the first bad field. */
+	void validate(const std::string& section = "insertOpts") const;
 };
 
 /** What one frame would do to a grid, counted before it is applied. */

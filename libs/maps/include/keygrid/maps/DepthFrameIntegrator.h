@@ -16,6 +16,7 @@
  * discretizeEndpoints (the default, = OctoMap's discretize=true) one ray is cast per distinct
  * end voxel, to its centre; otherwise one per pixel.
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
 #include <mrpt/poses/CPose3D.h>
@@ -66,10 +67,12 @@ struct DepthIntegrationOptions
 	 * 64 MB) */
 	double maxDenseMarkVoxels{64.0 * 1024 * 1024};
 
+	/** The INI keys, with description and rule. */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
-	/** Throws std::invalid_argument naming the key and value of the first bad field. */
-	void validate() const;
+	/** Throws std::invalid_argument naming [section], key and value of the first bad field. */
+	void validate(const std::string& section = "insertOpts") const;
 };
 
 /** The voxels one frame updates, each once, grouped by block. */

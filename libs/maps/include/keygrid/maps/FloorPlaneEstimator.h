@@ -4,6 +4,7 @@
  * not gravity aligned (TUM). The floor is taken as the LOWEST large plane roughly perpendicular
  * to an "up" hint (a desk top is often larger in view than the floor) that lies below the camera.
  */
+#include <keygrid/core/OptionFields.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/TPoint3D.h>
 #include <mrpt/poses/CPose3D.h>
@@ -33,10 +34,12 @@ struct FloorPlaneRansacOptions
 	/** Random seed, so the estimate is reproducible (Default: 1) */
 	uint32_t seed{1};
 
-	/** Keys prefixed with "floorRansac_" in `section`. */
+	/** INI keys prefixed with "floorRansac_" (they live in another struct's section). */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const;
-	void validate() const;
+	/** Throws std::invalid_argument naming [section], key and value of the first bad field. */
+	void validate(const std::string& section = "insertOpts") const;
 };
 
 /** Plane n . p + d = 0 with unit normal n pointing up (towards the camera). */

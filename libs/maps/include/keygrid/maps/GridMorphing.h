@@ -48,6 +48,7 @@
  * cube crosses one block face): no bit, no lookup. Optionally (maxKeyframesPerBlock) only the K
  * keyframes with the most readable voxels times weight are kept per block: an approximation.
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
 #include <mrpt/poses/CPose3D.h>
@@ -110,9 +111,13 @@ struct MorphingOptions
 		Trilinear = 1
 	} interpolation{Interpolation::Trilinear};
 
+	/** The INI keys (prefixed "morph", they share the insertion section), with description and
+	 * rule. */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
-	void validate() const;
+	/** Throws std::invalid_argument naming [section], key and value of the first bad field. */
+	void validate(const std::string& section = "insertOpts") const;
 };
 
 /** One keyframe as morphing sees it. */

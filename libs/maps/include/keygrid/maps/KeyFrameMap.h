@@ -48,7 +48,8 @@ struct MapCorrection
 	/** The keyframes that moved: the pose each was inserted with (or last corrected to) and
 	 * its corrected pose. */
 	TrajectoryCorrection poses;
-	/** The run's floor frame, when it moved under the corrected poses. */
+	/** The run's floor frame under the corrected poses (given, or the newest estimate);
+	 * nullopt while none is known. */
 	std::optional<mrpt::poses::CPose3D> T_world_floor;
 };
 

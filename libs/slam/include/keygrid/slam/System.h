@@ -140,6 +140,15 @@ class System
 	const std::vector<loop::LoopClosureEvent>& loopClosures() const { return m_loops; }
 	/** Report of the final global bundle adjustment (finish()); empty when it did not run. */
 	const std::optional<sfm::BundleAdjusterReport>& globalBundleAdjustmentReport() const { return m_globalBa; }
+	/** finish(): how far the final refinement moved the keyframes the maps hold (largest move
+	 * of a camera centre or of the point refinement.map_reanchor_depth ahead of it) [m], and
+	 * whether the maps were re-anchored for it (more than refinement.map_reanchor_min_shift). */
+	struct FinalMapShift
+	{
+		double largest{0};
+		bool reanchored{false};
+	};
+	const std::optional<FinalMapShift>& finalMapShift() const { return m_finalMapShift; }
 	/** Threaded mode: what stopped the mapping or loop-closing thread (empty if nothing did).
 	 * processExtracted() throws it; after finish() it is kept here. */
 	std::string backgroundError() const;
@@ -242,6 +251,7 @@ class System
 	std::unique_ptr<loop::LoopCloser> m_loopCloser;
 	std::vector<loop::LoopClosureEvent> m_loops;
 	std::optional<sfm::BundleAdjusterReport> m_globalBa;
+	std::optional<FinalMapShift> m_finalMapShift;
 	double m_travelled{0};
 	std::optional<mrpt::poses::CPose3D> m_lastTrackedPose;
 	/** m_map.corrections() when the tracking side last re-based its travelled distance. */
