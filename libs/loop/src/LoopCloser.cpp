@@ -142,8 +142,8 @@ void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 	fields().read(c, s);
 	core::validateFields(*this, s);
 	// The vocabulary's size and the verification's other parameters.
+	ransac.validate(s);
 	std::string why;
-	if (!ransac.isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
 	if (!vocabularyOptions.isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
 }
 

@@ -9,43 +9,43 @@
 
 namespace keygrid::loop
 {
+core::OptionFields RigidRansacOptions::fields()
+{
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("inlier_threshold", inlierThreshold, "3D distance for inliers [m]", R::positive());
+	f.add("min_inliers", minInliers, "inliers needed to accept", R::atLeast(3));
+	f.add("max_iterations", maxIterations, "RANSAC hypotheses at most", R::atLeast(1));
+	f.add("confidence", confidence, "early stop probability", R::between(0, 1));
+	f.add("refinement_rounds", refinementRounds, "re-fits on inliers", R::atLeast(0));
+	f.add("estimate_scale", estimateScale, "Sim(3) instead of SE(3)");
+	f.add("seed", seed, "sampler seed");
+	return f;
+}
+
+void RigidRansacOptions::validate(const std::string& section) const { core::validateFields(*this, section); }
+
 bool RigidRansacOptions::isValid(std::string* why) const
 {
-	auto fail = [&](const std::string& s) {
-		if (why) *why = s;
+	try
+	{
+		validate();
+	}
+	catch (const std::invalid_argument& e)
+	{
+		if (why) *why = e.what();
 		return false;
-	};
-	if (!(inlierThreshold > 0)) return fail("inlier_threshold = " + std::to_string(inlierThreshold) + " (must be > 0)");
-	if (minInliers < 3) return fail("min_inliers = " + std::to_string(minInliers) + " (must be >= 3)");
-	if (maxIterations < 1) return fail("max_iterations = " + std::to_string(maxIterations) + " (must be >= 1)");
-	if (!(confidence > 0 && confidence < 1)) return fail("confidence = " + std::to_string(confidence) + " (must be in (0, 1))");
-	if (refinementRounds < 0) return fail("refinement_rounds = " + std::to_string(refinementRounds) + " (must be >= 0)");
+	}
 	return true;
 }
 
 void RigidRansacOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	inlierThreshold = c.read_double(s, "inlier_threshold", inlierThreshold);
-	minInliers = c.read_int(s, "min_inliers", minInliers);
-	maxIterations = c.read_int(s, "max_iterations", maxIterations);
-	confidence = c.read_double(s, "confidence", confidence);
-	refinementRounds = c.read_int(s, "refinement_rounds", refinementRounds);
-	estimateScale = c.read_bool(s, "estimate_scale", estimateScale);
-	seed = c.read_uint64_t(s, "seed", seed);
-	std::string why;
-	if (!isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
+	fields().read(c, s);
+	validate(s);
 }
 
-void RigidRansacOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	c.write(s, "inlier_threshold", inlierThreshold, 34, 40, "3D distance for inliers [m]");
-	c.write(s, "min_inliers", minInliers, 34, 40, "inliers needed to accept");
-	c.write(s, "max_iterations", maxIterations, 34, 40, "RANSAC hypotheses at most");
-	c.write(s, "confidence", confidence, 34, 40, "early stop probability");
-	c.write(s, "refinement_rounds", refinementRounds, 34, 40, "re-fits on inliers");
-	c.write(s, "estimate_scale", estimateScale, 34, 40, "Sim(3) instead of SE(3)");
-	c.write(s, "seed", seed, 34, 40, "sampler seed");
-}
+void RigidRansacOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
 
 namespace
 {
@@ -93,8 +93,7 @@ RigidRansacResult estimateRigidTransformRansac(
 	if (p_a.size() != p_b.size())
 		throw std::invalid_argument(
 			"estimateRigidTransformRansac: " + std::to_string(p_a.size()) + " vs " + std::to_string(p_b.size()) + " points");
-	std::string why;
-	if (!opts.isValid(&why)) throw std::invalid_argument("RigidRansacOptions: " + why);
+	opts.validate();
 	RigidRansacResult res;
 	const std::size_t n = p_a.size();
 	res.inlier.assign(n, 0);

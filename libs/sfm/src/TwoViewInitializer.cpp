@@ -1,7 +1,6 @@
 // TwoViewInitializer: options, model selection and the choice among motion hypotheses
 // (Mur-Artal et al. 2015, section IV). Model fits: _models.cpp; hypothesis checks:
 // _reconstruct.cpp.
-#include <keygrid/core/ConfigReading.h>
 #include <keygrid/sfm/TwoViewInitializer.h>
 
 #include <Eigen/Dense>
@@ -17,55 +16,48 @@
 
 namespace keygrid::sfm
 {
-void TwoViewOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
+core::OptionFields TwoViewOptions::fields()
 {
-	ransacIterations = static_cast<int>(core::readInteger(c, s, "ransac_iterations", ransacIterations, 1, 100000));
-	seed = static_cast<uint64_t>(core::readWholeNumber(c, s, "seed", static_cast<long long>(seed)));
-	sigmaPx = core::readFiniteNumber(c, s, "sigma_px", sigmaPx);
-	minMatches = static_cast<int>(core::readInteger(c, s, "min_matches", minMatches, 8, 1000000));
-	minParallaxDeg = core::readFiniteNumber(c, s, "min_parallax_deg", minParallaxDeg);
-	minPointParallaxDeg = core::readFiniteNumber(c, s, "min_point_parallax_deg", minPointParallaxDeg);
-	minTriangulated = static_cast<int>(core::readInteger(c, s, "min_triangulated", minTriangulated, 1, 1000000));
-	minGoodShare = core::readFiniteNumber(c, s, "min_good_share", minGoodShare);
-	maxSecondBestShare = core::readFiniteNumber(c, s, "max_second_best_share", maxSecondBestShare);
-	homographyRatio = core::readFiniteNumber(c, s, "homography_ratio", homographyRatio);
-	homographyInlierShare = core::readFiniteNumber(c, s, "homography_inlier_share", homographyInlierShare);
-	parallel = core::readBoolean(c, s, "parallel", parallel);
-	std::string err;
-	if (!isValid(&err)) throw std::invalid_argument("[" + s + "] " + err);
+	using R = core::OptionRule;
+	core::OptionFields f;
+	f.add("ransac_iterations", ransacIterations, "RANSAC draws shared by H and F", R::inRange(1, 100000));
+	f.add("seed", seed, "RNG seed (reproducible runs)");
+	f.add("sigma_px", sigmaPx, "keypoint std at level 0 [px]", R::positive());
+	f.add("min_matches", minMatches, "fewer correspondences are refused (the 8-point needs 8)", R::inRange(8, 1000000));
+	f.add("min_parallax_deg", minParallaxDeg, "median parallax needed [deg]", R::fromBelow(0, 90));
+	f.add("min_point_parallax_deg", minPointParallaxDeg, "a map point needs this parallax [deg]", R::fromBelow(0, 90));
+	f.add("min_triangulated", minTriangulated, "map points needed", R::inRange(1, 1000000));
+	f.add("min_good_share", minGoodShare, "share of inliers the chosen motion must explain", R::inRange(0, 1));
+	f.add("max_second_best_share", maxSecondBestShare, "second-best / best good points above: ambiguous", R::aboveUpTo(0, 1));
+	f.add("homography_ratio", homographyRatio, "R_H = S_H / (S_H + S_F) above: homography", R::between(0, 1));
+	f.add("homography_inlier_share", homographyInlierShare, "H inliers / F inliers from which F is degenerate", R::aboveUpTo(0, 1));
+	f.add("parallel", parallel, "score H and F in parallel");
+	return f;
 }
 
-void TwoViewOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
+void TwoViewOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	c.write(s, "ransac_iterations", ransacIterations, 30, 40, "RANSAC draws shared by H and F");
-	c.write(s, "seed", std::to_string(seed), 30, 40, "RNG seed (reproducible runs)");
-	c.write(s, "sigma_px", sigmaPx, 30, 40, "keypoint std at level 0 [px]");
-	c.write(s, "min_matches", minMatches, 30, 40, "fewer correspondences are refused");
-	c.write(s, "min_parallax_deg", minParallaxDeg, 30, 40, "median parallax needed [deg]");
-	c.write(s, "min_point_parallax_deg", minPointParallaxDeg, 30, 40, "a map point needs this parallax [deg]");
-	c.write(s, "min_triangulated", minTriangulated, 30, 40, "map points needed");
-	c.write(s, "min_good_share", minGoodShare, 30, 40, "share of inliers the chosen motion must explain");
-	c.write(s, "max_second_best_share", maxSecondBestShare, 30, 40, "second-best / best good points above: ambiguous");
-	c.write(s, "homography_ratio", homographyRatio, 30, 40, "R_H = S_H / (S_H + S_F) above: homography");
-	c.write(s, "homography_inlier_share", homographyInlierShare, 30, 40, "H inliers / F inliers from which F is degenerate");
-	c.write(s, "parallel", parallel, 30, 40, "score H and F in parallel");
+	fields().read(c, s);
+	validate(s);
 }
+
+void TwoViewOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
+
+void TwoViewOptions::validate(const std::string& section) const { core::validateFields(*this, section); }
 
 bool TwoViewOptions::isValid(std::string* error) const
 {
-	std::ostringstream e;
-	if (ransacIterations < 1) e << "ransac_iterations = " << ransacIterations << " (must be >= 1)";
-	else if (!(sigmaPx > 0)) e << "sigma_px = " << sigmaPx << " (must be > 0)";
-	else if (minMatches < 8) e << "min_matches = " << minMatches << " (must be >= 8: the 8-point needs 8)";
-	else if (!(minParallaxDeg >= 0 && minParallaxDeg < 90)) e << "min_parallax_deg = " << minParallaxDeg << " (must be in [0, 90))";
-	else if (!(minPointParallaxDeg >= 0 && minPointParallaxDeg < 90)) e << "min_point_parallax_deg = " << minPointParallaxDeg << " (must be in [0, 90))";
-	else if (minTriangulated < 1) e << "min_triangulated = " << minTriangulated << " (must be >= 1)";
-	else if (!(minGoodShare >= 0 && minGoodShare <= 1)) e << "min_good_share = " << minGoodShare << " (must be in [0, 1])";
-	else if (!(maxSecondBestShare > 0 && maxSecondBestShare <= 1)) e << "max_second_best_share = " << maxSecondBestShare << " (must be in (0, 1])";
-	else if (!(homographyRatio > 0 && homographyRatio < 1)) e << "homography_ratio = " << homographyRatio << " (must be in (0, 1))";
-	else if (!(homographyInlierShare > 0 && homographyInlierShare <= 1)) e << "homography_inlier_share = " << homographyInlierShare << " (must be in (0, 1])";
-	if (error) *error = e.str();
-	return e.str().empty();
+	try
+	{
+		validate();
+	}
+	catch (const std::invalid_argument& e)
+	{
+		if (error) *error = e.what();
+		return false;
+	}
+	if (error) error->clear();
+	return true;
 }
 
 const char* toString(TwoViewFailure f)
@@ -94,8 +86,7 @@ const char* toString(TwoViewModel m)
 
 TwoViewInitializer::TwoViewInitializer(const PinholeIntrinsics& K, const TwoViewOptions& opts) : m_K(K), m_opts(opts)
 {
-	std::string err;
-	if (!opts.isValid(&err)) throw std::invalid_argument("TwoViewOptions: " + err);
+	opts.validate();
 	if (!(K.fx > 0 && K.fy > 0)) throw std::invalid_argument("TwoViewInitializer: focal lengths must be > 0");
 }
 

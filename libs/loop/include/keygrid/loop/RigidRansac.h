@@ -5,6 +5,8 @@
  * frame) -> T_a_b with p_a ~= T_a_b p_b, by RANSAC over minimal sets of 3 pairs, closed-form
  * Horn/Umeyama fits (Eigen::umeyama), then refinement on the inliers until the set is stable.
  */
+#include <keygrid/core/OptionFields.h>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -36,6 +38,11 @@ struct RigidRansacOptions
 	/** Seed of the sampler: the same inputs and seed give the same result (Default: 42) */
 	std::uint64_t seed{42};
 
+	/** The INI keys, with description and rule (core/OptionFields.h). */
+	core::OptionFields fields();
+	/** Throws std::invalid_argument("[section] key = value (must be ...)") on a bad value. */
+	void validate(const std::string& section = "ransac") const;
+	/** validate() as a flag, its message in `why`. */
 	bool isValid(std::string* why = nullptr) const;
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;

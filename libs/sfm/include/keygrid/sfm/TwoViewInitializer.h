@@ -19,6 +19,7 @@
  *    before its points are triangulated: the linear estimates are several times less accurate
  *    than the noise allows.
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/RgbdReprojectionCost.h>
 #include <keygrid/sfm/TwoViewGeometry.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -71,8 +72,13 @@ struct TwoViewOptions
 	 * (Default: true) */
 	bool parallel{true};
 
+	/** The INI keys, with description and rule (core/OptionFields.h). */
+	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	/** Throws std::invalid_argument("[section] key = value (must be ...)") on a bad value. */
+	void validate(const std::string& section = "two_view") const;
+	/** validate() as a flag, its message in `error`. */
 	bool isValid(std::string* error = nullptr) const;
 };
 
