@@ -8,6 +8,7 @@
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 
@@ -271,4 +272,41 @@ TEST(RawlogEntryCheck, AnImageEntryOfItsOwnHasItsJpegDecodedToo)
 	ASSERT_NE(at, bytes.end());
 	*at = 0x58;
 	EXPECT_NE(check(bytes).find("CImage entry: its "), std::string::npos) << check(bytes);
+}
+
+TEST(RawlogEntryCheck, AnImageObservationIsWalkedAndItsJpegDecoded)
+{
+	// The monocular input's entry: walked to its end, at the top level and in a sensory frame;
+	// a damaged JPEG image or sensor label is named.
+	auto obs = mrpt::obs::CObservationImage::Create();
+	obs->image = mrpt::img::CImage(40, 30, mrpt::img::CH_RGB);
+	obs->image.filledRectangle(0, 0, 39, 29, mrpt::img::TColor(30, 160, 90));
+	obs->cameraParams.setIntrinsicParamsFromValues(50, 50, 19.5, 14.5);
+	obs->sensorLabel = "CAMERA";
+	const auto raw = serialize(*obs);
+	std::vector<std::uint8_t> head;
+	EXPECT_EQ(check(raw, &head), "");
+	EXPECT_EQ(head.size(), raw.size() - 1) << "walked to the entry's end byte";
+	mrpt::obs::CSensoryFrame sf;
+	sf.insert(obs);
+	EXPECT_EQ(check(serialize(sf)), "");
+
+	// The label is its uint32 length (6, little-endian) and "CAMERA": make the length 2^31 + 6.
+	auto longLabel = raw;
+	const std::uint8_t label[10] = {6, 0, 0, 0, 'C', 'A', 'M', 'E', 'R', 'A'};
+	const auto labelAt = std::search(longLabel.begin(), longLabel.end(), label, label + 10);
+	ASSERT_NE(labelAt, longLabel.end());
+	labelAt[3] = 0x80;
+	EXPECT_NE(check(longLabel).find("CObservationImage sensor label of "), std::string::npos) << check(longLabel);
+
+	const bool before = mrpt::img::CImage::DISABLE_JPEG_COMPRESSION();
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(false);
+	auto jpeg = serialize(*obs);
+	mrpt::img::CImage::DISABLE_JPEG_COMPRESSION(before);
+	EXPECT_EQ(check(jpeg), "");
+	const std::uint8_t soi[3] = {0xFF, 0xD8, 0xFF};
+	const auto at = std::search(jpeg.begin(), jpeg.end(), soi, soi + 3);
+	ASSERT_NE(at, jpeg.end()) << "a JPEG inside the entry";
+	*at = 0x14;
+	EXPECT_NE(check(jpeg).find("CObservationImage image: its "), std::string::npos) << check(jpeg);
 }

@@ -5,9 +5,11 @@
 #include <keygrid/core/RgbdObservation.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/system/filesystem.h>
+#include <opencv2/core.hpp>
 
 #include "TestData.h"
 
+#include <cstdio>
 #include <fstream>
 
 using namespace keygrid::core;
@@ -121,4 +123,106 @@ TEST(RawlogFrameSource, SkipsNonRgbdAndReportsTruncation)
 	EXPECT_TRUE(threw || n < 2) << "a truncated rawlog must not yield every frame silently";
 	EXPECT_THROW(RawlogFrameSource("/nonexistent.rawlog"), std::runtime_error);
 	EXPECT_THROW(openFrameSource("/nonexistent/path"), std::runtime_error);
+}
+
+TEST(RawlogFrameSource, DepthIgnoredGivesTheImagesOfTheRgbdFrames)
+{
+	// A real (unregistered) Kinect frame: the image-only frame is the RGB-D frame's grey and
+	// colour image in the same camera, without depth.
+	const std::string path = keygrid::test::mrptDatasetsDir() + "/tests_rgbd.rawlog";
+	if (!mrpt::system::fileExists(path)) GTEST_SKIP() << path << " missing (package mrpt-common)";
+	Frame rgbd, mono;
+	RawlogFrameSource withDepth(path);
+	ASSERT_TRUE(withDepth.next(rgbd));
+	ASSERT_TRUE(rgbd.hasDepth());
+	FrameSourceOptions so;
+	so.depth = DepthUse::Ignore;
+	RawlogFrameSource imagesOnly(path, so);
+	ASSERT_TRUE(imagesOnly.next(mono));
+	EXPECT_FALSE(mono.hasDepth());
+	EXPECT_TRUE(mono.depthRaw.empty());
+	EXPECT_EQ(cv::norm(mono.grey, rgbd.grey, cv::NORM_INF), 0.0);
+	EXPECT_EQ(cv::norm(mono.colour, rgbd.colour, cv::NORM_INF), 0.0);
+	EXPECT_EQ(mono.timestamp, rgbd.timestamp);
+	EXPECT_EQ(mono.camera.fx, rgbd.camera.fx);
+	EXPECT_EQ(mono.camera.cy, rgbd.camera.cy);
+	EXPECT_EQ(mono.camera.dist, rgbd.camera.dist);
+	EXPECT_FALSE(imagesOnly.next(mono));
+	EXPECT_EQ(imagesOnly.skippedCount(), 0u);
+}
+
+TEST(RawlogFrameSource, DepthIgnoredLoadsNoDepth)
+{
+	// Range images stored in external files that are gone: RGB-D mode cannot load them and skips
+	// the entries; with depth ignored they are never opened, and entries without any range
+	// image are frames too.
+	const std::string dir = keygrid::test::scratchDir("rawlog_nodepth");
+	// A 12 x 9 frame: a grey ramp, depth 1 m.
+	Frame f;
+	f.camera.width = 12;
+	f.camera.height = 9;
+	f.grey.create(9, 12, CV_8UC1);
+	for (int r = 0; r < 9; r++)
+		for (int c = 0; c < 12; c++) f.grey.at<std::uint8_t>(r, c) = static_cast<std::uint8_t>(20 * r + c);
+	f.depthRaw = cv::Mat(9, 12, CV_16UC1, cv::Scalar(5000));
+	const std::string imagesDir = dir + "/ext_Images";
+	mrpt::system::createDirectory(imagesDir);
+	{
+		RawlogWriter w(dir + "/ext.rawlog");
+		auto noRange = makeRgbdObservation(f);
+		noRange->hasRangeImage = false;
+		noRange->rangeImage.setSize(0, 0);
+		w.write(noRange);
+		auto external = makeRgbdObservation(f);
+		external->rangeImage_convertToExternalStorage("range_0.bin", imagesDir + "/");
+		w.write(external);
+		w.close();
+	}
+	ASSERT_TRUE(mrpt::system::fileExists(imagesDir + "/range_0.bin"));
+	{
+		// While the file exists, RGB-D mode reads its depth: the setup stores depth externally.
+		RawlogFrameSource src(dir + "/ext.rawlog");
+		Frame g;
+		ASSERT_TRUE(src.next(g)) << src.lastSkipReason();
+		EXPECT_EQ(g.depthRaw.at<uint16_t>(3, 4), 5000);
+	}
+	std::remove((imagesDir + "/range_0.bin").c_str());
+	{
+		RawlogFrameSource src(dir + "/ext.rawlog");
+		Frame g;
+		EXPECT_FALSE(src.next(g));
+		EXPECT_EQ(src.skippedCount(), 2u);
+		EXPECT_NE(src.lastSkipReason().find("rawlog entry 1: cannot load external image"), std::string::npos)
+			<< src.lastSkipReason();
+	}
+	FrameSourceOptions so;
+	so.depth = DepthUse::Ignore;
+	RawlogFrameSource src(dir + "/ext.rawlog", so);
+	Frame g;
+	for (int i = 0; i < 2; i++)
+	{
+		ASSERT_TRUE(src.next(g)) << src.lastSkipReason();
+		EXPECT_FALSE(g.hasDepth());
+		EXPECT_EQ(cv::norm(g.grey, f.grey, cv::NORM_INF), 0.0);
+	}
+	EXPECT_FALSE(src.next(g));
+	EXPECT_EQ(src.skippedCount(), 0u);
+}
+
+TEST(RawlogFrameSource, DepthIgnoredSkipsOtherSensorsNamingThem)
+{
+	const std::string dir = keygrid::test::scratchDir("rawlog_nodepth_other");
+	{
+		RawlogWriter w(dir + "/laser.rawlog");
+		w.write(mrpt::obs::CObservation2DRangeScan::Create());
+		w.close();
+	}
+	FrameSourceOptions so;
+	so.depth = DepthUse::Ignore;
+	RawlogFrameSource src(dir + "/laser.rawlog", so);
+	Frame g;
+	EXPECT_FALSE(src.next(g));
+	EXPECT_EQ(src.skippedCount(), 1u);
+	EXPECT_NE(src.lastSkipReason().find("CObservation2DRangeScan is not an image observation"), std::string::npos)
+		<< src.lastSkipReason();
 }

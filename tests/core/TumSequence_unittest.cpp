@@ -4,10 +4,30 @@
 #include "SyntheticTum.h"
 #include "TestData.h"
 
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
 using namespace keygrid::core;
+
+namespace
+{
+/** The message of the std::runtime_error `f` throws ("" when it throws none). */
+template <typename F>
+std::string runtimeErrorOf(F f)
+{
+	try
+	{
+		f();
+	}
+	catch (const std::runtime_error& e)
+	{
+		return e.what();
+	}
+	return {};
+}
+}  // namespace
 
 TEST(TimestampAssociation, NearestUniqueWithinTolerance)
 {
@@ -145,4 +165,97 @@ TEST(TumSequence, SharedFr1DeskIsIndexedWithFr1Camera)
 		EXPECT_LT(median, 3.0);
 	}
 	EXPECT_EQ(n, 9u);
+}
+
+TEST(TumSequence, DepthIgnoredReadsTheColourImagesAloneWithoutOpeningDepth)
+{
+	const auto s = keygrid::test::writeSyntheticTum(keygrid::test::scratchDir("tumseq_mono"), 3, 8, 6);
+	FrameSourceOptions rgbd;
+	rgbd.camera = RgbdCamera::Preset("fr1");
+	rgbd.camera->width = 8;
+	rgbd.camera->height = 6;
+	FrameSourceOptions mono = rgbd;
+	mono.depth = DepthUse::Ignore;
+	// The same images, timestamps and camera as in RGB-D mode, without depth (a reused frame
+	// keeps no stale depth).
+	{
+		TumFrameSource a(s.dir, rgbd), b(s.dir, mono);
+		EXPECT_EQ(b.sequence().indexSource(), "rgb.txt");
+		EXPECT_FALSE(b.sequence().hasDepth());
+		EXPECT_NE(b.describe().find("3 images from rgb.txt, depth ignored"), std::string::npos) << b.describe();
+		Frame fa, fb;
+		for (int i = 0; i < 3; i++)
+		{
+			ASSERT_TRUE(a.next(fa));
+			fb = fa;
+			ASSERT_TRUE(b.next(fb));
+			EXPECT_FALSE(fb.hasDepth());
+			EXPECT_TRUE(fb.depthRaw.empty());
+			EXPECT_EQ(cv::norm(fb.colour, s.colour[i], cv::NORM_INF), 0.0);
+			EXPECT_EQ(cv::norm(fb.grey, fa.grey, cv::NORM_INF), 0.0);
+			EXPECT_EQ(fb.timestamp, fa.timestamp);
+			EXPECT_NEAR(fb.timestamp, s.tRgb[i], 1e-6);  // rgb.txt holds microseconds
+			EXPECT_EQ(fb.camera.fx, fa.camera.fx);
+		}
+		EXPECT_FALSE(b.next(fb));
+	}
+	// Depth PNGs that cannot be decoded are never opened.
+	const TumSequence pairs(s.dir);
+	for (const auto& p : pairs.pairs()) std::ofstream(p.depthPath) << "not a png";
+	{
+		TumFrameSource b(s.dir, mono);
+		Frame f;
+		for (int i = 0; i < 3; i++) ASSERT_TRUE(b.next(f));
+		TumFrameSource a(s.dir, rgbd);
+		EXPECT_THROW(a.next(f), std::runtime_error);
+	}
+	// Only associations.txt lists the images: its colour column.
+	std::remove((s.dir + "/rgb.txt").c_str());
+	{
+		TumFrameSource b(s.dir, mono);
+		EXPECT_EQ(b.sequence().indexSource(), "associations.txt");
+		Frame f;
+		ASSERT_TRUE(b.next(f));
+		EXPECT_EQ(cv::norm(f.colour, s.colour[0], cv::NORM_INF), 0.0);
+		EXPECT_FALSE(f.hasDepth());
+	}
+	// No list of colour images: an error naming the folder.
+	std::remove((s.dir + "/associations.txt").c_str());
+	const std::string noList = runtimeErrorOf([&] { TumFrameSource b(s.dir, mono); });
+	EXPECT_NE(noList.find("'" + s.dir + "' has neither rgb.txt nor associations.txt"), std::string::npos) << noList;
+}
+
+TEST(TumSequence, FolderWithoutDepthIsAnImageOnlyInput)
+{
+	// rgb.txt and rgb/ alone, as a monocular camera's TUM folder.
+	const auto s = keygrid::test::writeSyntheticTum(keygrid::test::scratchDir("tumseq_rgbonly"), 2, 8, 6, false);
+	std::filesystem::remove_all(s.dir + "/depth");
+	std::remove((s.dir + "/depth.txt").c_str());
+	FrameSourceOptions o;
+	o.camera = RgbdCamera::Preset("kinect");
+	o.camera->width = 8;
+	o.camera->height = 6;
+	o.depth = DepthUse::Ignore;
+	TumFrameSource src(s.dir, o);
+	EXPECT_EQ(src.sizeHint().value(), 2u);
+	Frame f;
+	ASSERT_TRUE(src.next(f));
+	EXPECT_EQ(cv::norm(f.colour, s.colour[0], cv::NORM_INF), 0.0);
+	EXPECT_NEAR(f.timestamp, s.tRgb[0], 1e-6);
+	EXPECT_FALSE(f.hasDepth());
+	// Asked for depth: an error naming the folder and what is missing.
+	o.depth = DepthUse::Use;
+	const std::string noDepth = runtimeErrorOf([&] { TumFrameSource rgbd(s.dir, o); });
+	EXPECT_NE(noDepth.find("'" + s.dir + "' has neither associations.txt nor depth.txt"), std::string::npos) << noDepth;
+	// A missing colour image names the file, as in RGB-D mode.
+	std::remove(TumSequence(s.dir, 0.02, DepthUse::Ignore).pairs()[1].rgbPath.c_str());
+	o.depth = DepthUse::Ignore;
+	TumFrameSource gap(s.dir, o);
+	ASSERT_TRUE(gap.next(f));
+	const std::string missing = runtimeErrorOf([&] { gap.next(f); });
+	EXPECT_NE(missing.find("missing image '" + s.dir + "/rgb/"), std::string::npos) << missing;
+	// An empty rgb.txt gives no image: an error naming the folder.
+	std::ofstream(s.dir + "/rgb.txt") << "# nothing\n";
+	const std::string none = runtimeErrorOf([&] { TumSequence(s.dir, 0.02, DepthUse::Ignore); });
+	EXPECT_NE(none.find("'" + s.dir + "': rgb.txt gives no colour image"), std::string::npos) << none;
 }

@@ -106,6 +106,29 @@ TEST(CISMOccupancyGrid2D, HeightBandSelectsObstacles)
 	EXPECT_EQ(grid.cellState(grid.x2idx(1.025), cy), CellState::Occupied);
 }
 
+/* heightBand with the most slices allowed (64): an obstacle in the last slice (0.8875-0.90 m),
+ * then rays to a lower point further on that cross its cell's column in that slice, coming from
+ * a camera above the band: they clear it. The column then reads unknown, not free: no ray saw
+ * its ground clearance. */
+TEST(CISMOccupancyGrid2D, RaysThroughTheBandsTopSliceClearIt)
+{
+	CISMOccupancyGrid2D grid;
+	auto& o = grid.insertionOptions;
+	o.obstacleMinHeight = 0.1;
+	o.obstacleMaxHeight = 0.9;
+	o.bandSliceHeight = (o.obstacleMaxHeight - o.obstacleMinHeight) / 64;
+	const auto camera = keygrid::test::SyntheticRoom().cameraPose(0.025, 0.025, 0.95, 0.0, 0.0);
+	const int cx = grid.x2idx(1.025), cy = grid.y2idx(0.025);
+	grid.insertKeyframePoints(1, camera, {TPoint3D(1.025, 0.025, 0.895)});
+	ASSERT_EQ(grid.cellState(cx, cy), CellState::Occupied);
+	// From (0.025, 0.95) to (3.025, 0.785): 0.8964-0.8936 m over the column at x = 1.0-1.05.
+	uint64_t id = 2;
+	while (grid.cellState(cx, cy) == CellState::Occupied && id < 40)
+		grid.insertKeyframePoints(id++, camera, {TPoint3D(3.025, 0.025, 0.785)});
+	EXPECT_EQ(grid.cellState(cx, cy), CellState::Unknown);
+	EXPECT_LE(id, 12u);
+}
+
 TEST(CISMOccupancyGrid2D, GrowsToContainFarPoints)
 {
 	CISMOccupancyGrid2D::TCreationOptions c;

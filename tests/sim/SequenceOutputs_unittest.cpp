@@ -5,6 +5,7 @@
 #include <keygrid/core/TumTrajectory.h>
 #include <keygrid/sim/GroundTruthOccupancy.h>
 #include <keygrid/sim/SequenceWriter.h>
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/system/filesystem.h>
 #include <opencv2/imgcodecs.hpp>
 
@@ -232,4 +233,126 @@ TEST(SequenceOutputs, AWriteErrorLeavesNoListOrRawlogUnderItsFinalName)
 	for (const char* f : {"sequence.rawlog", "groundtruth.txt", "tum/rgb.txt", "tum/depth.txt", "tum/associations.txt"})
 		EXPECT_FALSE(std::filesystem::exists(dir + "/" + f)) << f;
 	for (const auto& file : listFiles(dir)) EXPECT_EQ(file.find(".tmp"), std::string::npos) << file;
+}
+
+TEST(SequenceOutputs, MonocularSequenceHasTheRgbdImagesWithoutDepth)
+{
+	const sim::Scene scene = test::sceneFromString(tinyRoomIni(6));
+	sim::OutputOptions o;
+	o.voxelResolution = o.floorPlanResolution = 0;
+	const std::string rgbd = test::scratchDir("sim_mono_rgbd"), mono = test::scratchDir("sim_mono");
+	sim::writeSequence(scene, rgbd, o, {}, 2);
+	o.sensor = sim::RecordedSensor::Monocular;
+	sim::writeSequence(scene, mono, o, {}, 2);
+
+	// The TUM folder has the colour images and rgb.txt alone; images and ground truth are the
+	// RGB-D sequence's, byte for byte.
+	const auto files = listFiles(mono);
+	for (const auto& f : files)
+		EXPECT_EQ(f.find("depth"), std::string::npos) << f;
+	EXPECT_FALSE(std::filesystem::exists(mono + "/tum/associations.txt"));
+	EXPECT_EQ(listFiles(mono + "/tum/rgb"), listFiles(rgbd + "/tum/rgb"));
+	for (const auto& f : listFiles(mono + "/tum/rgb"))
+		EXPECT_EQ(slurp(mono + "/tum/rgb/" + f), slurp(rgbd + "/tum/rgb/" + f)) << f;
+	for (const char* f : {"groundtruth.txt", "tum/groundtruth.txt", "tum/rgb.txt", "tum/camera.ini"})
+		EXPECT_EQ(slurp(mono + "/" + f), slurp(rgbd + "/" + f)) << f;
+
+	// The rawlog holds CObservationImage: image-only frames equal to the RGB-D rawlog's images,
+	// in the same camera; RGB-D mode skips them, and the TUM folder refuses to give depth.
+	core::FrameSourceOptions imagesOnly;
+	imagesOnly.depth = core::DepthUse::Ignore;
+	core::RawlogFrameSource a(rgbd + "/sequence.rawlog"), b(mono + "/sequence.rawlog", imagesOnly);
+	core::TumFrameSource t(mono + "/tum", imagesOnly);
+	core::Frame fa, fb, ft;
+	std::size_t n = 0;
+	while (a.next(fa))
+	{
+		ASSERT_TRUE(b.next(fb)) << b.lastSkipReason();
+		ASSERT_TRUE(t.next(ft));
+		EXPECT_FALSE(fb.hasDepth());
+		EXPECT_FALSE(ft.hasDepth());
+		EXPECT_EQ(cv::norm(fa.colour, fb.colour, cv::NORM_INF), 0.0);
+		EXPECT_EQ(cv::norm(fa.grey, fb.grey, cv::NORM_INF), 0.0);
+		EXPECT_EQ(cv::norm(fb.colour, ft.colour, cv::NORM_INF), 0.0);
+		EXPECT_EQ(fa.timestamp, fb.timestamp);
+		EXPECT_NEAR(fb.timestamp, ft.timestamp, 1e-6);
+		EXPECT_EQ(fb.camera.fx, fa.camera.fx);
+		EXPECT_EQ(fb.camera.width, 160u);
+		n++;
+	}
+	EXPECT_EQ(n, 4u);
+	EXPECT_FALSE(b.next(fb));
+	core::RawlogFrameSource asRgbd(mono + "/sequence.rawlog");
+	EXPECT_FALSE(asRgbd.next(fa));
+	EXPECT_EQ(asRgbd.skippedCount(), 4u);
+	try
+	{
+		core::TumFrameSource withDepth(mono + "/tum");
+		FAIL();
+	}
+	catch (const std::runtime_error& e)
+	{
+		EXPECT_NE(std::string(e.what()).find(mono + "/tum' has neither associations.txt nor depth.txt"), std::string::npos)
+			<< e.what();
+	}
+}
+
+TEST(SequenceOutputs, OutputSensorKeyIsReadSavedAndChecked)
+{
+	mrpt::config::CConfigFileMemory cfg;
+	sim::OutputOptions o;
+	o.sensor = sim::RecordedSensor::Monocular;
+	o.saveToConfigFile(cfg, "output");
+	EXPECT_EQ(cfg.read_string("output", "sensor", ""), "monocular");
+	sim::OutputOptions back;
+	back.loadFromConfigFile(cfg, "output");
+	EXPECT_EQ(back.sensor, sim::RecordedSensor::Monocular);
+	cfg.write("output", "sensor", "rgbd");
+	back.loadFromConfigFile(cfg, "output");
+	EXPECT_EQ(back.sensor, sim::RecordedSensor::Rgbd);
+	cfg.write("output", "sensor", "stereo");
+	try
+	{
+		back.loadFromConfigFile(cfg, "output");
+		FAIL();
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("[output] sensor = 'stereo'"), std::string::npos) << e.what();
+	}
+}
+
+TEST(SequenceOutputs, BenchmarkSceneRendersAsMonocularThroughTheTool)
+{
+	// keygrid-sim --set 'output.sensor=monocular' on the shipped room_loop scene (camera at a
+	// fixed height): a monocular sequence the image-only sources read.
+	const std::string out = test::scratchDir("sim_tool_mono");
+	std::string log;
+	ASSERT_EQ(
+		test::runCommand(
+			test::toolPath("keygrid-sim") + " --quiet --frames 2 --voxel-resolution 0 --floorplan-resolution 0 " +
+				"--set 'output.sensor=monocular' --scene " + test::sourceDir() + "/config/sim/room_loop.ini --output " + out,
+			&log),
+		0)
+		<< log;
+	EXPECT_FALSE(std::filesystem::exists(out + "/tum/depth"));
+	EXPECT_FALSE(std::filesystem::exists(out + "/tum/depth.txt"));
+	core::FrameSourceOptions imagesOnly;
+	imagesOnly.depth = core::DepthUse::Ignore;
+	for (const std::string& input : {out + "/sequence.rawlog", out + "/tum"})
+	{
+		auto src = core::openFrameSource(input, imagesOnly);
+		core::Frame f;
+		std::size_t n = 0;
+		while (src->next(f))
+		{
+			EXPECT_FALSE(f.hasDepth()) << input;
+			EXPECT_EQ(f.grey.size(), cv::Size(640, 480)) << input;
+			n++;
+		}
+		EXPECT_EQ(n, 2u) << input;
+		EXPECT_EQ(src->skippedCount(), 0u) << input << ": " << src->lastSkipReason();
+	}
+	// Camera height above the floor (z = 0): the scene's, for every frame.
+	for (const auto& p : core::readTumTrajectory(out + "/groundtruth.txt")) EXPECT_NEAR(p.T_world_cam.z(), 1.30, 1e-4);
 }

@@ -149,6 +149,20 @@ class EntryWalker
 		return kWalked;
 	}
 
+	/** Walks a CObservationImage (version 4, MRPT 2.x): CPose3D cameraPose, TCamera
+	 * cameraParams, CImage image, uint64 timestamp, string sensorLabel. Older versions nest
+	 * matrix objects (not walked). */
+	Step walkImageObservation(std::uint8_t version)
+	{
+		if (version != 4) return std::nullopt;
+		KEYGRID_WALK(pose());
+		KEYGRID_WALK(camera());
+		KEYGRID_WALK(image(""));
+		if (!m_r.value<std::uint64_t>()) return std::nullopt;
+		KEYGRID_WALK(string("sensor label"));
+		return kWalked;
+	}
+
    private:
 	std::uint64_t left() const { return core::left(m_l, m_r, m_start); }
 	std::string tooLarge(const std::string& what, std::uint64_t bytes) const
@@ -234,11 +248,11 @@ class EntryWalker
 	 * (uint32 n, n bytes). MRPT hands a JPEG to libjpeg with its default error handler, which
 	 * ends the process (exit(), no exception) on a damaged stream: it is decoded here first, by
 	 * OpenCV, whose libjpeg error handler returns an error instead. */
-	Step image(const char* which)
+	Step image(const std::string& which)
 	{
 		const auto h = m_r.header();
 		if (!h) return std::nullopt;
-		return imageBody(h->second, std::string(which) + " image");
+		return imageBody(h->second, which.empty() ? "image" : which + " image");
 	}
 
    public:
@@ -327,11 +341,16 @@ std::string checkRangeScan(Reader& r, std::uint8_t version, const RawlogEntryLim
 {
 	return EntryWalker(r, l, start).walk(version).value_or("");
 }
+std::string checkImageObservation(Reader& r, std::uint8_t version, const RawlogEntryLimits& l, std::size_t start)
+{
+	return EntryWalker(r, l, start, "CObservationImage").walkImageObservation(version).value_or("");
+}
 std::string checkEntry(Reader& r, const RawlogEntryLimits& limits, std::size_t start)
 {
 	const auto h = r.header();
 	if (!h) return {};
 	if (isClass(h->first, "CObservation3DRangeScan")) return checkRangeScan(r, h->second, limits, start);
+	if (isClass(h->first, "CObservationImage")) return checkImageObservation(r, h->second, limits, start);
 	// An image on its own (not an observation, skipped later): its JPEG is decoded all the same.
 	if (isClass(h->first, "CImage")) return EntryWalker(r, limits, start, "CImage").imageBody(h->second, "entry").value_or("");
 	// CSensoryFrame (version 2): uint32 count, then the observations as objects.
@@ -345,6 +364,8 @@ std::string checkEntry(Reader& r, const RawlogEntryLimits& limits, std::size_t s
 		const auto first = r.header();
 		if (first && isClass(first->first, "CObservation3DRangeScan"))
 			return checkRangeScan(r, first->second, limits, start);
+		if (first && isClass(first->first, "CObservationImage"))
+			return checkImageObservation(r, first->second, limits, start);
 	}
 	return {};
 }

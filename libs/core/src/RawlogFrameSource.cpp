@@ -1,3 +1,4 @@
+#include <keygrid/core/ImageObservation.h>
 #include <keygrid/core/RawlogEntryCheck.h>
 #include <keygrid/core/RawlogFrameSource.h>
 #include <keygrid/core/RgbdObservation.h>
@@ -5,6 +6,7 @@
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CRawlog.h>
 #include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
@@ -34,13 +36,13 @@ std::string innermostReason(const std::string& what)
 struct RawlogFrameSource::Impl
 {
 	mrpt::io::CFileGZInputStream file;
-	std::deque<mrpt::obs::CObservation3DRangeScan::Ptr> pending;
+	std::deque<mrpt::obs::CObservation::Ptr> pending;  //!< CObservation3DRangeScan or CObservationImage
 	std::size_t entry{0};
 	bool eof{false};
 };
 
-RawlogFrameSource::RawlogFrameSource(const std::string& path)
-	: m_impl(std::make_unique<Impl>()), m_path(path)
+RawlogFrameSource::RawlogFrameSource(const std::string& path, const FrameSourceOptions& opts)
+	: m_impl(std::make_unique<Impl>()), m_path(path), m_depth(opts.depth), m_camera(opts.camera)
 {
 	if (!mrpt::system::fileExists(path))
 		throw std::runtime_error("rawlog '" + path + "' does not exist");
@@ -70,7 +72,41 @@ RawlogFrameSource::~RawlogFrameSource() = default;
 
 std::size_t RawlogFrameSource::bytesRead() const { return m_impl->file.getPosition(); }
 
-std::string RawlogFrameSource::describe() const { return "MRPT rawlog " + m_path; }
+std::string RawlogFrameSource::describe() const
+{
+	return "MRPT rawlog " + m_path + (m_depth == DepthUse::Ignore ? " (images only, depth ignored)" : "");
+}
+
+bool RawlogFrameSource::loadAndConvert(const mrpt::obs::CObservation& obs, Frame& out, std::string& why) const
+{
+	using namespace mrpt::obs;
+	const std::string entry = "rawlog entry " + std::to_string(m_impl->entry - 1) + ": ";
+	const auto* scan = dynamic_cast<const CObservation3DRangeScan*>(&obs);
+	const auto* image = dynamic_cast<const CObservationImage*>(&obs);
+	try
+	{
+		// Brings in externally stored images; without depth, the intensity image alone.
+		if (scan && m_depth == DepthUse::Ignore)
+			scan->intensityImage.forceLoad();
+		else
+			obs.load();
+	}
+	catch (const std::exception& e)
+	{
+		why = entry + "cannot load external image: " + e.what();
+		return false;
+	}
+	bool ok = false;
+	if (scan && m_depth == DepthUse::Use)
+		ok = frameFromObservation(*scan, out, &why);
+	else if (scan)
+		ok = imageFrameFromObservation(*scan, out, &why);
+	else if (image)
+		ok = frameFromImageObservation(*image, out, m_camera, &why);
+	obs.unload();
+	if (!ok) why = entry + why;
+	return ok;
+}
 
 bool RawlogFrameSource::next(Frame& out)
 {
@@ -79,26 +115,14 @@ bool RawlogFrameSource::next(Frame& out)
 	{
 		while (!m_impl->pending.empty())
 		{
-			auto obs = m_impl->pending.front();
+			const auto obs = m_impl->pending.front();
 			m_impl->pending.pop_front();
-			try
-			{
-				obs->load();  // brings in externally stored images, if any
-			}
-			catch (const std::exception& e)
-			{
-				noteSkip(
-					"rawlog entry " + std::to_string(m_impl->entry - 1) +
-					": cannot load external image: " + e.what());
-				continue;
-			}
 			std::string why;
-			if (!frameFromObservation(*obs, out, &why))
+			if (!loadAndConvert(*obs, out, why))
 			{
-				noteSkip("rawlog entry " + std::to_string(m_impl->entry - 1) + ": " + why);
+				noteSkip(why);
 				continue;
 			}
-			obs->unload();
 			out.index = m_nextIndex++;
 			return true;
 		}
@@ -154,14 +178,16 @@ bool RawlogFrameSource::next(Frame& out)
 				"rawlog entry " + std::to_string(m_impl->entry - 1) + ": unexpected object " +
 				(obj ? std::string(obj->GetRuntimeClass()->className) : std::string("(null)")));
 		// Other sensors' observations (a rawlog-grabber log may hold an IMU or a laser too) are
-		// skipped and counted, so that a rawlog with no RGB-D entry says why it gave no frame.
+		// skipped and counted, so that a rawlog with no usable entry says why it gave no frame.
 		auto take = [&](const CObservation::Ptr& o) {
-			if (auto s = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
-				m_impl->pending.push_back(s);
+			const bool usable = std::dynamic_pointer_cast<CObservation3DRangeScan>(o) ||
+				(m_depth == DepthUse::Ignore && std::dynamic_pointer_cast<CObservationImage>(o));
+			if (usable)
+				m_impl->pending.push_back(o);
 			else if (o)
 				noteSkip(
 					"rawlog entry " + std::to_string(m_impl->entry - 1) + ": " + o->GetRuntimeClass()->className +
-					" is not an RGB-D observation");
+					(m_depth == DepthUse::Use ? " is not an RGB-D observation" : " is not an image observation"));
 		};
 		if (obs) take(obs);
 		if (sf)

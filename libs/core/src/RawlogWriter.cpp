@@ -2,6 +2,7 @@
 #include <keygrid/core/RawlogWriter.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CObservationImage.h>
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 
@@ -35,8 +36,13 @@ RawlogWriter::~RawlogWriter() = default;  // an uncommitted AtomicGzFile removes
 void RawlogWriter::write(const mrpt::obs::CObservation::Ptr& obs)
 {
 	if (m_opts.externalImages)
-		if (auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(obs);
-			o && o->hasIntensityImage && !o->intensityImage.isExternallyStored())
+	{
+		mrpt::img::CImage* img = nullptr;
+		if (auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(obs); o && o->hasIntensityImage)
+			img = &o->intensityImage;
+		else if (auto i = std::dynamic_pointer_cast<mrpt::obs::CObservationImage>(obs))
+			img = &i->image;
+		if (img && !img->isExternallyStored())
 		{
 			if (!mrpt::system::directoryExists(m_imagesDir) &&
 				!mrpt::system::createDirectory(m_imagesDir))
@@ -44,9 +50,10 @@ void RawlogWriter::write(const mrpt::obs::CObservation::Ptr& obs)
 			char name[64];
 			std::snprintf(name, sizeof(name), "rgb_%06zu.png", m_count);
 			const std::string full = m_imagesDir + "/" + name;
-			writeFileThrough(full, [&](const std::string& tmp) { return o->intensityImage.saveToFile(tmp); });
-			o->intensityImage.setExternalStorage(name);  // relative to the images dir
+			writeFileThrough(full, [&](const std::string& tmp) { return img->saveToFile(tmp); });
+			img->setExternalStorage(name);  // relative to the images dir
 		}
+	}
 	if (!m_impl->out) throw std::logic_error("RawlogWriter: write after close");
 	m_impl->chunk.clear();
 	auto arch = mrpt::serialization::archiveFrom(m_impl->chunk);

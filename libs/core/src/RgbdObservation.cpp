@@ -2,7 +2,6 @@
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/core/RgbdObservation.h>
 #include <mrpt/system/datetime.h>
-#include <opencv2/imgproc.hpp>
 
 #include <cmath>
 #include <limits>
@@ -49,6 +48,20 @@ cv::Mat rawFromMetres(const cv::Mat& depth, float units)
 		}
 	}
 	return raw;
+}
+
+/** The camera of the intensity image, checked against it. Empty string when usable, else why
+ * not: calibrations that disagree with the image (or hold NaN) would index outside it later. */
+std::string intensityCamera(const mrpt::obs::CObservation3DRangeScan& obs, float units, RgbdCamera& cam)
+{
+	cam = RgbdCamera::FromTCamera(obs.cameraParamsIntensity, units);
+	std::string err;
+	if (!cam.isValid(&err)) return "invalid intensity camera parameters: " + err;
+	if (cam.width != obs.intensityImage.getWidth() || cam.height != obs.intensityImage.getHeight())
+		return "intensity camera parameters are for " + std::to_string(cam.width) + "x" +
+			std::to_string(cam.height) + " but the image is " + std::to_string(obs.intensityImage.getWidth()) +
+			"x" + std::to_string(obs.intensityImage.getHeight());
+	return {};
 }
 }  // namespace
 
@@ -117,16 +130,9 @@ bool frameFromObservation(
 			std::to_string(obs.intensityImage.getHeight()) + " and range image " +
 			std::to_string(cols) + "x" + std::to_string(rows) + " differ in size");
 
-	// Calibrations that disagree with the images (or hold NaN) would index outside the images
-	// later: reject the observation here, saying why.
-	const RgbdCamera intensityCam = RgbdCamera::FromTCamera(obs.cameraParamsIntensity, obs.rangeUnits);
-	std::string err;
-	if (!intensityCam.isValid(&err)) return fail("invalid intensity camera parameters: " + err);
-	if (intensityCam.width != obs.intensityImage.getWidth() || intensityCam.height != obs.intensityImage.getHeight())
-		return fail(
-			"intensity camera parameters are for " + std::to_string(intensityCam.width) + "x" +
-			std::to_string(intensityCam.height) + " but the image is " +
-			std::to_string(obs.intensityImage.getWidth()) + "x" + std::to_string(obs.intensityImage.getHeight()));
+	RgbdCamera intensityCam;
+	std::string err = intensityCamera(obs, obs.rangeUnits, intensityCam);
+	if (!err.empty()) return fail(err);
 	const bool registered = obs.doDepthAndIntensityCamerasCoincide() && obs.cameraParams == obs.cameraParamsIntensity;
 	if (!registered)
 	{
@@ -154,19 +160,27 @@ bool frameFromObservation(
 			obs.relativePoseIntensityWRTDepth);
 	out.depth = depthRawToMetres(out.depthRaw, obs.rangeUnits);
 	const cv::Mat& img = obs.intensityImage.asCvMatRef();
-	if (img.channels() == 3)
-	{
-		out.colour = img.clone();
-		cv::cvtColor(img, out.grey, cv::COLOR_BGR2GRAY);
-	}
-	else if (img.channels() == 1)
-	{
-		out.colour.release();
-		out.grey = img.clone();
-	}
-	else
-		return fail("intensity image has " + std::to_string(img.channels()) + " channels");
+	if (!setFrameImages(img, out)) return fail("intensity image has " + std::to_string(img.channels()) + " channels");
 	return true;
+}
+
+bool imageFrameFromObservation(
+	const mrpt::obs::CObservation3DRangeScan& obs, Frame& out, std::string* why)
+{
+	// The depth unit only completes the camera description: the one stored when valid, so that
+	// the camera equals the RGB-D frame's, else the default.
+	const float units = obs.rangeUnits > 0 && std::isfinite(obs.rangeUnits) ? obs.rangeUnits : RgbdCamera{}.depthUnits;
+	RgbdCamera cam;
+	std::string err = !obs.hasIntensityImage || obs.intensityImage.isEmpty() ? "observation has no intensity image"
+																			  : intensityCamera(obs, units, cam);
+	if (err.empty())
+	{
+		const cv::Mat& img = obs.intensityImage.asCvMatRef();
+		if (!setImageOnlyFrame(img, mrpt::Clock::toDouble(obs.timestamp), cam, out))
+			err = "intensity image has " + std::to_string(img.channels()) + " channels";
+	}
+	if (why && !err.empty()) *why = err;
+	return err.empty();
 }
 
 }  // namespace keygrid::core

@@ -11,7 +11,7 @@
 namespace keygrid::core
 {
 TumFrameSource::TumFrameSource(const std::string& dir, const FrameSourceOptions& opts)
-	: m_seq(dir, opts.maxAssociationDt),
+	: m_seq(dir, opts.maxAssociationDt, opts.depth),
 	  m_camera(opts.camera ? *opts.camera : m_seq.guessCamera())
 {
 	for (const auto& is : m_seq.issues()) noteSkip(is.str());
@@ -20,17 +20,24 @@ TumFrameSource::TumFrameSource(const std::string& dir, const FrameSourceOptions&
 std::string TumFrameSource::describe() const
 {
 	return "TUM folder " + m_seq.dir() + " (" + std::to_string(m_seq.pairs().size()) +
-		" pairs from " + m_seq.indexSource() + ", camera " + m_camera.name + ")";
+		(m_seq.hasDepth() ? " pairs from " : " images from ") + m_seq.indexSource() +
+		(m_seq.hasDepth() ? "" : ", depth ignored") + ", camera " + m_camera.name + ")";
 }
 
 void TumFrameSource::loadPair(std::size_t i, cv::Mat& colour, cv::Mat& depthRaw) const
 {
 	const TumPair& p = m_seq.pairs().at(i);
-	for (const auto* f : {&p.rgbPath, &p.depthPath})
-		if (!mrpt::system::fileExists(*f))
-			throw std::runtime_error("missing image '" + *f + "'");
+	if (!mrpt::system::fileExists(p.rgbPath)) throw std::runtime_error("missing image '" + p.rgbPath + "'");
+	if (m_seq.hasDepth() && !mrpt::system::fileExists(p.depthPath))
+		throw std::runtime_error("missing image '" + p.depthPath + "'");
 	colour = readImage(p.rgbPath, cv::IMREAD_COLOR);
 	if (colour.empty()) throw std::runtime_error("cannot decode image '" + p.rgbPath + "'");
+	if (!m_seq.hasDepth())
+	{
+		depthRaw.release();
+		checkImageSize(p.rgbPath, colour);
+		return;
+	}
 	depthRaw = readImage(p.depthPath, cv::IMREAD_ANYDEPTH);
 	if (depthRaw.empty()) throw std::runtime_error("cannot decode depth image '" + p.depthPath + "'");
 	if (depthRaw.type() != CV_16UC1)
@@ -41,10 +48,15 @@ void TumFrameSource::loadPair(std::size_t i, cv::Mat& colour, cv::Mat& depthRaw)
 			"image sizes differ: '" + p.rgbPath + "' is " + std::to_string(colour.cols) + "x" +
 			std::to_string(colour.rows) + ", '" + p.depthPath + "' is " +
 			std::to_string(depthRaw.cols) + "x" + std::to_string(depthRaw.rows));
+	checkImageSize(p.rgbPath, colour);
+}
+
+void TumFrameSource::checkImageSize(const std::string& path, const cv::Mat& colour) const
+{
 	if (static_cast<unsigned>(colour.cols) != m_camera.width ||
 		static_cast<unsigned>(colour.rows) != m_camera.height)
 		throw std::runtime_error(
-			"image '" + p.rgbPath + "' is " + std::to_string(colour.cols) + "x" +
+			"image '" + path + "' is " + std::to_string(colour.cols) + "x" +
 			std::to_string(colour.rows) + " but camera '" + m_camera.name + "' is " +
 			std::to_string(m_camera.width) + "x" + std::to_string(m_camera.height));
 }
@@ -53,7 +65,10 @@ void TumFrameSource::loadFrame(std::size_t i, Frame& out) const
 {
 	loadPair(i, out.colour, out.depthRaw);
 	cv::cvtColor(out.colour, out.grey, cv::COLOR_BGR2GRAY);
-	out.depth = depthRawToMetres(out.depthRaw, m_camera.depthUnits);
+	if (m_seq.hasDepth())
+		out.depth = depthRawToMetres(out.depthRaw, m_camera.depthUnits);
+	else
+		out.depth.release();
 	out.camera = m_camera;
 	out.timestamp = m_seq.pairs()[i].tRgb;
 	out.index = i;
@@ -73,7 +88,7 @@ std::unique_ptr<FrameSource> openFrameSource(const std::string& path, const Fram
 	std::error_code ec;
 	if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
 		throw std::runtime_error("input '" + path + "' is neither a rawlog file nor a TUM folder (a device or a pipe?)");
-	if (mrpt::system::fileExists(path)) return std::make_unique<RawlogFrameSource>(path);
+	if (mrpt::system::fileExists(path)) return std::make_unique<RawlogFrameSource>(path, opts);
 	throw std::runtime_error("input '" + path + "' does not exist");
 }
 

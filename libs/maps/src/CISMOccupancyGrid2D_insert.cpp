@@ -5,6 +5,7 @@
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
+#include <keygrid/maps/FloorToInt.h>
 #include <keygrid/maps/GridRayTraversal.h>
 
 #include <algorithm>
@@ -49,8 +50,8 @@ struct RigidF
 };
 
 /** Combines two updates of one cell from the same keyframe: occupied evidence wins (as in
- * OctoMap), otherwise the most confident free update. Each cell thus changes once per keyframe,
- * whatever the number of rays crossing it. */
+ * OctoMap), otherwise the most confident free update; the result does not depend on the order of
+ * the updates. Each cell thus changes once per keyframe, whatever the number of rays crossing it. */
 inline float combine(float cur, float inc)
 {
 	if (cur > 0.0f || inc > 0.0f) return std::max(cur, inc);
@@ -101,7 +102,7 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 	const float hMin = static_cast<float>(o.obstacleMinHeight), hMax = static_cast<float>(o.obstacleMaxHeight);
 	const float fTol = static_cast<float>(o.floorTolerance);
 	const float sliceH = static_cast<float>(o.bandSliceHeight);
-	auto sliceOf = [&](float z) { return std::clamp(static_cast<int>(std::floor((z - hMin) / sliceH)), 0, m_bandSlices - 1); };
+	auto sliceOf = [&](float z) { return std::clamp(floorToInt((z - hMin) / sliceH), 0, m_bandSlices - 1); };
 
 	// 1) classify and collect the rays in the floor frame, with their bounding box.
 	struct Ray
@@ -158,15 +159,18 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 			r.cell = inside(x2idx(r.ex), y2idx(r.ey)) ? x2idx(r.ex) + y2idx(r.ey) * m_sizeX : -1;
 			if (r.obstacle) r.slices = uint64_t{1} << sliceOf(r.ez);
 		}
-		std::sort(rays.begin(), rays.end(), [](const Ray& a, const Ray& b) {
-			if (a.obstacle != b.obstacle) return a.obstacle;
+		// Only the obstacle rays are grouped: a cell's combined increment does not depend on
+		// the order of the rays (see combine()).
+		const auto obstaclesEnd = std::partition(rays.begin(), rays.end(), [](const Ray& r) { return r.obstacle; });
+		std::sort(rays.begin(), obstaclesEnd, [](const Ray& a, const Ray& b) {
 			if (a.cell != b.cell) return a.cell < b.cell;
 			return a.range < b.range;
 		});
+		const size_t obstacles = static_cast<size_t>(obstaclesEnd - rays.begin());
 		size_t keep = 0;
 		for (size_t i = 0; i < rays.size(); i++)
 		{
-			if (rays[i].obstacle && keep > 0 && rays[keep - 1].obstacle && rays[keep - 1].cell == rays[i].cell && rays[i].cell >= 0)
+			if (i < obstacles && keep > 0 && rays[keep - 1].cell == rays[i].cell && rays[i].cell >= 0)
 			{
 				rays[keep - 1].slices |= rays[i].slices;
 				continue;
@@ -221,6 +225,25 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 		if (inc > 0.0f)
 			for (uint64_t m = extra; m; m &= m - 1) touchSlot(base + 1 + static_cast<size_t>(__builtin_ctzll(m)), inc);
 	};
+	/* touchBand() for the exact-free increment lFree, which most visits get: it only marks the
+	 * column's slots in a bit mask, and each marked slot gets lFree once after the tracing
+	 * (combine() does not depend on the order), however many rays crossed the column. */
+	if (band && m_freeColumns.size() != m_logOdds.size()) m_freeColumns.assign(m_logOdds.size(), FreeColumn{});
+	auto markFree = [&](int cx, int cy, float za, float zb) {
+		if (!inside(cx, cy)) return;
+		if (za > zb) std::swap(za, zb);
+		const size_t cell = static_cast<size_t>(cx) + static_cast<size_t>(cy) * m_sizeX;
+		FreeColumn& c = m_freeColumns[cell];
+		const FreeColumn before = c;
+		if (za < hMin && zb >= -fTol) c.clearance = true;
+		if (zb >= hMin && za <= hMax)
+		{
+			const int k0 = sliceOf(za), k1 = sliceOf(zb);
+			const uint64_t upToK1 = k1 >= 63 ? ~uint64_t{0} : (uint64_t{1} << (k1 + 1)) - 1;
+			c.slices |= upToK1 & ~((uint64_t{1} << k0) - 1);
+		}
+		if (before.slices == 0 && !before.clearance && (c.slices != 0 || c.clearance)) m_freeTouched.push_back(cell);
+	};
 	// Log-odds increment of the practical ISM at distance r; exact-free / prior far from the band.
 	auto ismIncrement = [&](double r, const Ray& ray) -> float {
 		if (!ray.obstacle) return r <= ray.range ? lFree : 0.0f;
@@ -248,7 +271,11 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 				return;
 			}
 			const double ra = std::max(0.0, r - halfChord), rb = std::min(rEnd, r + halfChord);
-			touchBand(cx, cy, static_cast<float>(sz + slope * ra), static_cast<float>(sz + slope * rb), inc, ray.slices);
+			const float za = static_cast<float>(sz + slope * ra), zb = static_cast<float>(sz + slope * rb);
+			if (inc == lFree)
+				markFree(cx, cy, za, zb);
+			else
+				touchBand(cx, cy, za, zb, inc, ray.slices);
 		};
 		if (o.rayTraversal == RayTraversal::Bresenham)
 		{
@@ -274,6 +301,15 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 	const float lo = static_cast<float>(o.logOddsMin - l0), hi = static_cast<float>(o.logOddsMax - l0);
 	if (band)
 	{
+		for (size_t cell : m_freeTouched)
+		{
+			FreeColumn& c = m_freeColumns[cell];
+			const size_t base = cell * stride;
+			if (c.clearance) touchSlot(base, lFree);
+			for (uint64_t m = c.slices; m; m &= m - 1) touchSlot(base + 1 + static_cast<size_t>(__builtin_ctzll(m)), lFree);
+			c = FreeColumn{};
+		}
+		m_freeTouched.clear();
 		for (size_t idx : m_bandTouched)
 		{
 			m_band[idx] = std::clamp(m_band[idx] + m_bandScratch[idx], lo, hi);

@@ -18,10 +18,16 @@ void OutputOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
 	std::vector<std::string> keys;
 	c.getAllKeys(s, keys);
 	for (const auto& k : keys)
-		if (k != "write_rawlog" && k != "write_tum" && k != "write_mask" &&
+		if (k != "sensor" && k != "write_rawlog" && k != "write_tum" && k != "write_mask" &&
 			k != "external_images" && k != "voxel_resolution" && k != "floorplan_resolution" &&
 			k != "floorplan_z_min" && k != "floorplan_z_max" && k != "png_compression")
 			throw std::invalid_argument("[" + s + "] unknown key '" + k + "'");
+	if (const std::string v = ini::raw(c, s, "sensor"); v == "rgbd")
+		sensor = RecordedSensor::Rgbd;
+	else if (v == "monocular")
+		sensor = RecordedSensor::Monocular;
+	else if (!v.empty())
+		ini::fail(s, "sensor", v, "must be rgbd or monocular");
 	writeRawlog = ini::readBool(c, s, "write_rawlog", writeRawlog);
 	writeTum = ini::readBool(c, s, "write_tum", writeTum);
 	writeMask = ini::readBool(c, s, "write_mask", writeMask);
@@ -47,6 +53,7 @@ void OutputOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
 void OutputOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
 {
 	auto b = [](bool v) { return std::string(v ? "true" : "false"); };
+	c.write(s, "sensor", std::string(sensor == RecordedSensor::Monocular ? "monocular" : "rgbd"));
 	c.write(s, "write_rawlog", b(writeRawlog));
 	c.write(s, "write_tum", b(writeTum));
 	c.write(s, "write_mask", b(writeMask));

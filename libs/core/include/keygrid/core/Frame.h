@@ -9,8 +9,18 @@
 
 namespace keygrid::core
 {
+/** Whether a frame source delivers depth. Ignore reads the images alone (monocular input):
+ * depth stored in the input is neither loaded nor decoded, and an input without depth is
+ * accepted. */
+enum class DepthUse
+{
+	Use,
+	Ignore
+};
+
 /** An RGB-D frame: images as captured (distortion is described by `camera`, not removed),
- * depth registered to the colour image and converted to metres. */
+ * depth registered to the colour image and converted to metres. An image-only frame
+ * (DepthUse::Ignore, monocular input) has empty depth and depthRaw. */
 struct Frame
 {
 	/** Position in the source sequence, 0-based. */
@@ -31,6 +41,16 @@ struct Frame
 	bool hasDepth() const { return !depth.empty(); }
 	bool hasImage() const { return !grey.empty(); }
 };
+
+/** Sets out.grey (and out.colour for a 3-channel BGR image; released for a 1-channel one)
+ * from an image as captured. Returns false, leaving `out` as it was, for another channel
+ * count. */
+bool setFrameImages(const cv::Mat& image, Frame& out);
+
+/** Fills `out` as an image-only frame (monocular input): images as setFrameImages, timestamp
+ * and camera; depth and depthRaw released. Returns false, leaving `out` as it was, for an
+ * image of another channel count. */
+bool setImageOnlyFrame(const cv::Mat& image, double timestamp, const RgbdCamera& camera, Frame& out);
 
 /** Converts a raw depth image (CV_16UC1) to metres (CV_32FC1): depth = raw * units.
  * The one place where raw depth becomes metres, so every path gives the same bits. */

@@ -1,6 +1,7 @@
 #pragma once
 /** \file FrameSource.h
- * Streams RGB-D frames from a recorded sequence, one at a time.
+ * Streams frames from a recorded sequence, one at a time: RGB-D frames, or image-only frames
+ * (FrameSourceOptions::depth = DepthUse::Ignore) for the monocular mode.
  */
 #include <keygrid/core/Frame.h>
 
@@ -46,13 +47,17 @@ class FrameSource
 /** Options shared by the sources that need them. */
 struct FrameSourceOptions
 {
-	/** Camera used for TUM folders (Default: preset guessed from the folder name, else "kinect") */
+	/** Camera used for TUM folders, and for rawlog image observations recorded without a
+	 * calibration (Default: TUM: preset guessed from the folder name, else "kinect"; rawlog:
+	 * none, such observations are skipped) */
 	std::optional<RgbdCamera> camera;
 	/** Largest |t_rgb - t_depth| accepted when associating TUM lists [s] (Default: 0.02 s) */
 	double maxAssociationDt{0.02};
+	/** RGB-D frames, or image-only frames for the monocular mode (Default: Use) */
+	DepthUse depth{DepthUse::Use};
 };
 
-/** Opens `path`: a directory is read as a TUM RGB-D folder, a file as an MRPT rawlog.
+/** Opens `path`: a directory is read as a TUM folder, a file as an MRPT rawlog.
  * Throws std::runtime_error with the reason when it cannot be opened. */
 std::unique_ptr<FrameSource> openFrameSource(
 	const std::string& path, const FrameSourceOptions& opts = {});

@@ -13,10 +13,11 @@
  * libjpeg with the default error handler, which ends the process (exit()) on a damaged stream.
  *
  * Walked: a CObservation3DRangeScan (serialization versions 9 and 10, MRPT 2.x) to its end (its
- * range image and extra layers, images, cameras, strings), at the top level or as the first
- * observation of a CSensoryFrame, and a CImage entry of its own. Any other object (other
- * observation classes, whose images are not decoded first), or a layout this walker does not
- * know (pixel labels, old pose versions), ends the walk there: the rest is passed on unchecked.
+ * range image and extra layers, images, cameras, strings) and a CObservationImage (version 4:
+ * pose, camera, image, label), at the top level or as the first observation of a
+ * CSensoryFrame, and a CImage entry of its own. Any other object (other observation classes,
+ * whose images are not decoded first), or a layout this walker does not know (pixel labels,
+ * old pose versions), ends the walk there: the rest is passed on unchecked.
  */
 #include <mrpt/io/CStream.h>
 

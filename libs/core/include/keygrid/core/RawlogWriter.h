@@ -17,8 +17,9 @@ struct RawlogWriterOptions
 {
 	/** gzip level 0-9 (Default: 1: most of the size gain, little time) */
 	int compressionLevel{1};
-	/** Store intensity images as external PNG files in `<name>_Images/` instead of inside the
-	 * rawlog, the layout rawlog-grabber uses (Default: false) */
+	/** Store intensity images (CObservation3DRangeScan) and images (CObservationImage) as
+	 * external PNG files in `<name>_Images/` instead of inside the rawlog, the layout
+	 * rawlog-grabber uses (Default: false) */
 	bool externalImages{false};
 };
 

@@ -1,7 +1,8 @@
 #pragma once
 /** \file RgbdObservation.h
  * Frame <-> mrpt::obs::CObservation3DRangeScan, in the layout keygrid-tum2rawlog and
- * keygrid-sim write and every frame source reads.
+ * keygrid-sim write and every frame source reads (ImageObservation.h: the monocular
+ * counterpart, CObservationImage).
  */
 #include <keygrid/core/Frame.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -33,6 +34,14 @@ mrpt::obs::CObservation3DRangeScan::Ptr makeRgbdObservation(
  * Returns false and sets *why when the observation cannot be a frame (no range image,
  * no intensity image, size mismatch, non-coinciding cameras). */
 bool frameFromObservation(
+	const mrpt::obs::CObservation3DRangeScan& obs, Frame& out, std::string* why = nullptr);
+
+/** The image-only frame of an RGB-D observation (depth ignored: monocular input): the
+ * intensity image, its camera (cameraParamsIntensity, as frameFromObservation gives it) and
+ * the timestamp; depth and depthRaw empty. Only the intensity image needs to be loaded, and
+ * an observation without a range image is accepted. Returns false and sets *why when there
+ * is no usable intensity image or camera. */
+bool imageFrameFromObservation(
 	const mrpt::obs::CObservation3DRangeScan& obs, Frame& out, std::string* why = nullptr);
 
 }  // namespace keygrid::core

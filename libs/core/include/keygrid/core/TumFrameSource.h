@@ -1,6 +1,7 @@
 #pragma once
 /** \file TumFrameSource.h
- * Frames from a TUM RGB-D folder (colour PNG + 16-bit depth PNG per pair).
+ * Frames from a TUM RGB-D folder (colour PNG + 16-bit depth PNG per pair), or with depth
+ * ignored (monocular input) image-only frames from its colour PNGs.
  */
 #include <keygrid/core/FrameSource.h>
 #include <keygrid/core/TumSequence.h>
@@ -10,7 +11,9 @@ namespace keygrid::core
 class TumFrameSource : public FrameSource
 {
    public:
-	/** Indexes the folder (see TumSequence); the camera comes from opts.camera or is guessed. */
+	/** Indexes the folder (see TumSequence; opts.depth = DepthUse::Ignore: its colour images
+	 * alone, a folder without depth.txt or depth/ is fine); the camera comes from opts.camera
+	 * or is guessed. */
 	explicit TumFrameSource(const std::string& dir, const FrameSourceOptions& opts = {});
 
 	bool next(Frame& out) override;
@@ -20,15 +23,20 @@ class TumFrameSource : public FrameSource
 	const TumSequence& sequence() const { return m_seq; }
 	const RgbdCamera& camera() const { return m_camera; }
 
-	/** Loads pair i: colour (CV_8UC3) and raw depth (CV_16UC1) exactly as stored.
+	/** Loads pair i: colour (CV_8UC3) and raw depth (CV_16UC1) exactly as stored; with depth
+	 * ignored the colour image alone (depthRaw released, no depth file read).
 	 * Throws std::runtime_error naming the file when unreadable, of the wrong type, or when
 	 * the two images (or the camera) disagree in size. */
 	void loadPair(std::size_t i, cv::Mat& colour, cv::Mat& depthRaw) const;
 
-	/** Builds the Frame of pair i (the timestamp is the colour image's). */
+	/** Builds the Frame of pair i (the timestamp is the colour image's; no depth when the
+	 * sequence was indexed with depth ignored). */
 	void loadFrame(std::size_t i, Frame& out) const;
 
    private:
+	/** Throws naming `path` when the image's size is not the camera's. */
+	void checkImageSize(const std::string& path, const cv::Mat& colour) const;
+
 	TumSequence m_seq;
 	RgbdCamera m_camera;
 	std::size_t m_next{0};

@@ -374,6 +374,14 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	std::vector<float> m_scratch, m_bandScratch;
 	std::vector<int> m_touched;
 	std::vector<size_t> m_bandTouched;
+	/** heightBand scratch: the slots of a cell's column that get the exact-free update. */
+	struct FreeColumn
+	{
+		uint64_t slices{0};  ///< bit k: band slice k
+		bool clearance{false};  ///< the ground-clearance slot
+	};
+	std::vector<FreeColumn> m_freeColumns;
+	std::vector<size_t> m_freeTouched;
 
 	bool heightBand() const { return insertionOptions.freeSpaceModel == FreeSpaceModel::HeightBand; }
 	/** Number of height slices the insertion options ask for. */

@@ -8,6 +8,7 @@
  * (the world frame of the map); its centre is ((i+0.5)*res, ...). This is the same cell
  * convention as OctoMap (key = floor(x/res) + 32768), so voxels map 1:1 onto OcTree leaves.
  */
+#include <keygrid/maps/FloorToInt.h>
 #include <mrpt/math/TPoint3D.h>
 
 #include <array>
@@ -46,14 +47,6 @@ struct VoxelIndexHash
 			(static_cast<uint64_t>(static_cast<uint32_t>(v.z)) * 83492791u));
 	}
 };
-
-/** floor(x) as int32 without a libm call (baseline x86-64 has no SSE4.1 round instruction);
- * exact for |x| < 2^31. */
-inline int32_t floorToInt(double x)
-{
-	const int32_t i = static_cast<int32_t>(x);
-	return i - static_cast<int32_t>(x < static_cast<double>(i));
-}
 
 /** Contents of one voxel: 8 bytes. */
 struct Voxel

@@ -7,6 +7,9 @@
  *                              groundtruth.txt camera.ini (TUM RGB-D layout, depth = raw/5000 m)
  *   DIR/occupancy_voxels.txt   static-scene surface voxels (VoxelSet)
  *   DIR/floorplan.pgm/.yaml    static-scene 2D floor plan (FloorPlan, ROS map_server)
+ * A monocular sequence ([output] sensor = monocular) holds no depth: the rawlog has a
+ * CObservationImage per frame (core::makeImageObservation, what rawlog-grabber records for a
+ * USB camera) and tum/ has rgb/ [mask/] rgb.txt groundtruth.txt camera.ini.
  */
 #include <cstddef>
 #include <functional>
@@ -21,9 +24,18 @@ namespace keygrid::sim
 {
 class Scene;
 
+/** The sensor a written sequence comes from. */
+enum class RecordedSensor
+{
+	Rgbd,      //!< colour and depth
+	Monocular  //!< colour images alone (the depth is rendered, not written)
+};
+
 /** The [output] section. */
 struct OutputOptions
 {
+	/** Key `sensor`: `rgbd` or `monocular` (Default: rgbd) */
+	RecordedSensor sensor{RecordedSensor::Rgbd};
 	/** Write DIR/sequence.rawlog (Default: true) */
 	bool writeRawlog{true};
 	/** Write DIR/tum/ (Default: true) */
