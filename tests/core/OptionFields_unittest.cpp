@@ -6,6 +6,9 @@
 #include <keygrid/core/OptionFields.h>
 #include <mrpt/config/CConfigFileMemory.h>
 
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
 #include <functional>
 #include <sstream>
 #include <stdexcept>
@@ -135,6 +138,114 @@ TEST(OptionFields, WriteThenReadGivesTheSameValues)
 	EXPECT_EQ(b.radii, a.radii);
 	// The description is the written comment.
 	EXPECT_NE(text.find("// search radius [px]"), std::string::npos) << text;
+}
+
+namespace
+{
+/** One double and one float, written and read back through their table. */
+struct Numbers
+{
+	double d{0};
+	float x{0};
+
+	core::OptionFields fields()
+	{
+		core::OptionFields f;
+		f.add("d", d, "a double");
+		f.add("x", x, "a float");
+		return f;
+	}
+};
+
+/** `n` written into an INI text, and that text. */
+std::string writtenIni(Numbers n)
+{
+	mrpt::config::CConfigFileMemory mem;
+	n.fields().write(mem, "n");
+	std::string text;
+	mem.getContent(text);
+	return text;
+}
+
+Numbers readBack(Numbers n)
+{
+	Numbers back;
+	back.d = -7;
+	back.x = -7;
+	back.fields().read(mrpt::config::CConfigFileMemory(writtenIni(n)), "n");
+	return back;
+}
+
+template <typename T>
+std::uint64_t bits(T v)
+{
+	std::uint64_t b = 0;
+	std::memcpy(&b, &v, sizeof(v));
+	return b;
+}
+
+/** The value text of key `key` in an INI text (without padding and comment). */
+std::string valueIn(const std::string& ini, const std::string& key)
+{
+	return mrpt::config::CConfigFileMemory(ini).read_string("n", key, "?");
+}
+
+/** What MRPT's own write() makes of a number. */
+template <typename T>
+std::string mrptText(T v)
+{
+	mrpt::config::CConfigFileMemory mem;
+	mem.write("n", "v", v);
+	return mem.read_string("n", "v", "?");
+}
+}  // namespace
+
+// MRPT's write() keeps 6 decimals ("%f") or 7 significant digits ("%e"): 2/3 would read back as
+// 0.666667. The table writes floats and doubles so that they read back bit for bit.
+TEST(OptionFields, WrittenNumbersReadBackBitForBit)
+{
+	const std::vector<double> doubles{
+		0.1, 1e-9, 123456789.123, 2.0 / 3.0, -1.0 / 3.0, 0.000123456789, 67108864.0, 0.05, 1e300, 4.9e-324, 0.0, -0.0, 12345.678901234567, 123456789.0};
+	const std::vector<float> floats{0.1f, 1e-9f, 123456.789f, 2.0f / 3.0f, 0.000123456f, 3.4e38f, 1e-40f, 0.85f, 0.0f};
+	for (std::size_t i = 0; i < std::max(doubles.size(), floats.size()); i++)
+	{
+		Numbers n;
+		n.d = doubles[i % doubles.size()];
+		n.x = floats[i % floats.size()];
+		const Numbers back = readBack(n);
+		EXPECT_EQ(bits(back.d), bits(n.d)) << valueIn(writtenIni(n), "d") << " for " << n.d;
+		EXPECT_EQ(bits(back.x), bits(n.x)) << valueIn(writtenIni(n), "x") << " for " << n.x;
+	}
+}
+
+// Values that MRPT's text already keeps exactly are written as MRPT writes them; the others in
+// their shortest exact text.
+TEST(OptionFields, WrittenNumbersKeepMrptTextWhereItIsExact)
+{
+	for (const double v : {0.05, 0.25, 1e-9, 3.0, 0.0, 2.5e7})
+	{
+		Numbers n;
+		n.d = v;
+		n.x = static_cast<float>(v);
+		const std::string ini = writtenIni(n);
+		EXPECT_EQ(valueIn(ini, "d"), mrptText(v));
+		EXPECT_EQ(valueIn(ini, "x"), mrptText(static_cast<float>(v)));
+	}
+	Numbers n;
+	n.d = 2.0 / 3.0;
+	n.x = 123456.789f;
+	EXPECT_EQ(valueIn(writtenIni(n), "d"), "0.6666666666666666");
+	EXPECT_EQ(valueIn(writtenIni(n), "x"), "123456.79");
+	n.d = 123456789.123;
+	n.x = 1e-9f;
+	EXPECT_EQ(valueIn(writtenIni(n), "d"), "123456789.123");
+	EXPECT_EQ(valueIn(writtenIni(n), "x"), "1.000000e-09");
+	// A whole number keeps a decimal point, as MRPT's "%f" and "%e" do (a written default tells
+	// number keys from integer keys).
+	n.d = 123456789.0;
+	n.x = -16777215.0f;
+	EXPECT_EQ(valueIn(writtenIni(n), "d"), "123456789.0");
+	EXPECT_EQ(valueIn(writtenIni(n), "x"), "-16777215.0");
 }
 
 TEST(OptionFields, EveryFieldIsDescribed)

@@ -7,6 +7,9 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 using keygrid::test::runCommand;
 using keygrid::test::scratchDir;
@@ -69,6 +72,14 @@ TEST(VocabApp, BadCommandLinesFailWithOneLine)
 	EXPECT_NE(log.find("/nonexistent.bin"), std::string::npos) << log;
 	EXPECT_NE(runCommand(toolPath("keygrid-vocab") + " train --images . --features surf --output /tmp/x.bin", &log), 0);
 	EXPECT_NE(log.find("surf"), std::string::npos) << log;
+	// Training options are checked by the vocabulary options' rules, naming the option.
+	const std::vector<std::pair<std::string, std::string>> badOptions{
+		{"--k 1", "--k 1 (must be >= 2)"}, {"--threads -2", "--threads -2 (must be >= 0)"}, {"--k 10 --levels 10", "branching = 10, levels = 10"}};
+	for (const auto& [options, message] : badOptions)
+	{
+		EXPECT_EQ(runCommand(toolPath("keygrid-vocab") + " train --images . " + options + " --output /tmp/x.bin", &log), 2) << options;
+		EXPECT_NE(log.find(message), std::string::npos) << log;
+	}
 }
 
 TEST(VocabApp, ReadsARawlogAndRefusesToTrainOnOneImage)

@@ -270,33 +270,56 @@ TEST(Vocabulary, RejectsBadInput)
 	EXPECT_THROW(Vocabulary().transform(randomBinary(3, 32, rng)), std::logic_error);
 }
 
+namespace
+{
+/** The message of the std::invalid_argument that loading `ini` section [vocab] throws ("" if none). */
+std::string loadError(const std::string& ini)
+{
+	try
+	{
+		VocabularyOptions().loadFromConfigFile(mrpt::config::CConfigFileMemory(ini), "vocab");
+	}
+	catch (const std::invalid_argument& e)
+	{
+		return e.what();
+	}
+	return "";
+}
+}  // namespace
+
 TEST(VocabularyOptions, ConfigRoundTripAndInvalidKey)
 {
 	VocabularyOptions o;
 	o.branching = 7;
 	o.levels = 5;
+	o.maxIterations = 3;
 	o.seed = 99;
+	o.threads = 2;
 	mrpt::config::CConfigFileMemory cfg;
 	o.saveToConfigFile(cfg, "vocab");
 	// Padded keys written by saveToConfigFile are read back from the text (as from a file).
 	std::string text;
 	cfg.getContent(text);
-	cfg.setContent(text);
+	EXPECT_NE(text.find("k: children per node"), std::string::npos) << text;
 	VocabularyOptions r;
-	r.loadFromConfigFile(cfg, "vocab");
+	r.loadFromConfigFile(mrpt::config::CConfigFileMemory(text), "vocab");
 	EXPECT_EQ(r.branching, 7);
 	EXPECT_EQ(r.levels, 5);
+	EXPECT_EQ(r.maxIterations, 3);
 	EXPECT_EQ(r.seed, 99u);
-	cfg.write("vocab", "levels", 0);
-	try
-	{
-		r.loadFromConfigFile(cfg, "vocab");
-		FAIL() << "expected an exception";
-	}
-	catch (const std::invalid_argument& e)
-	{
-		EXPECT_NE(std::string(e.what()).find("levels = 0"), std::string::npos) << e.what();
-	}
+	EXPECT_EQ(r.threads, 2);
+
+	// A value its rule refuses, a malformed one (read strictly), and too many words.
+	const std::string none = "[vocab]\n";
+	EXPECT_EQ(loadError(none + "levels = 0\n"), "[vocab] levels = 0 (must be >= 1)");
+	EXPECT_EQ(loadError(none + "branching = 1\n"), "[vocab] branching = 1 (must be >= 2)");
+	EXPECT_EQ(loadError(none + "threads = -1\n"), "[vocab] threads = -1 (must be >= 0)");
+	EXPECT_NE(loadError(none + "max_iterations = 5x\n").find("[vocab] max_iterations"), std::string::npos);
+	EXPECT_NE(loadError(none + "seed = -3\n").find("[vocab] seed"), std::string::npos);
+	EXPECT_NE(loadError(none + "branching = 10\nlevels = 10\n").find("[vocab] branching = 10, levels = 10"), std::string::npos);
+	EXPECT_EQ(loadError(none + "branching = 2\nlevels = 31\n"), "");
+	EXPECT_NE(loadError(none + "branching = 2\nlevels = 32\n"), "");
+	EXPECT_NO_THROW(VocabularyOptions{}.validate());
 }
 
 TEST(DirectIndexMatcher, RecoversAPermutationOfNoisyDescriptors)

@@ -35,6 +35,32 @@ std::string shortestText(T v)
 	return b;
 }
 
+/** What MRPT's CConfigFileBase::write() prints for a float or double: "%f" (6 decimals) for
+ * 1e-4 < |v| < 1e4 and for 0, "%e" (7 significant digits) otherwise. */
+template <typename T>
+std::string mrptText(T v)
+{
+	char b[64];
+	const bool fixed = (std::abs(v) > static_cast<T>(1e-4) && std::abs(v) < static_cast<T>(1e4)) || v == 0;
+	std::snprintf(b, sizeof(b), fixed ? "%f" : "%e", static_cast<double>(v));
+	return b;
+}
+
+/** The text written for a number field: MRPT's own form ("0.050000", "1.000000e-09") when it
+ * reads back as the same value, so files look as MRPT's maps write them; otherwise (2/3,
+ * 123456789.123, 0.000123456) the shortest text that does, as MRPT's form would change the value
+ * on a save and load. Either has a decimal point or an exponent, as MRPT's has: written
+ * defaults tell number keys from integer keys (slam::SlamConfig::checkKnownKeys). */
+template <typename T>
+std::string writtenText(T v)
+{
+	std::string text = mrptText(v);
+	if (static_cast<T>(std::strtod(text.c_str(), nullptr)) == v) return text;
+	text = shortestText(v);
+	if (text.find_first_of(".e") == std::string::npos) text += ".0";
+	return text;
+}
+
 /** The largest whole number readWholeNumber() parses (18 digits). */
 constexpr long long kMaxWhole = 999999999999999999LL;
 
@@ -175,6 +201,21 @@ std::string OptionField::valueText() const
 		member);
 }
 
+bool OptionField::accepted() const
+{
+	return std::visit(
+		[&](const auto& m) {
+			using P = std::decay_t<decltype(m)>;
+			if constexpr (std::is_same_v<P, CustomOptionValue>)
+				return rule.accepts(m.format());
+			else if constexpr (std::is_same_v<P, std::string*>)
+				return rule.accepts(*m);
+			else
+				return rule.accepts(static_cast<double>(*m));
+		},
+		member);
+}
+
 OptionFields::OptionFields(int nameWidth, int valueWidth) : m_nameWidth(nameWidth), m_valueWidth(valueWidth) {}
 
 OptionFields& OptionFields::addCustom(const std::string& key, CustomOptionValue value, const std::string& description, OptionRule rule)
@@ -219,8 +260,11 @@ void OptionFields::write(mrpt::config::CConfigFileBase& c, const std::string& s)
 	for (const auto& f : m_fields)
 		std::visit(
 			[&](const auto& m) {
-				if constexpr (std::is_same_v<std::decay_t<decltype(m)>, CustomOptionValue>)
+				using P = std::decay_t<decltype(m)>;
+				if constexpr (std::is_same_v<P, CustomOptionValue>)
 					c.write(s, f.key, m.format(), m_nameWidth, m_valueWidth, f.description);
+				else if constexpr (std::is_floating_point_v<std::remove_pointer_t<P>>)
+					c.write(s, f.key, writtenText(*m), m_nameWidth, m_valueWidth, f.description);
 				else
 					c.write(s, f.key, *m, m_nameWidth, m_valueWidth, f.description);
 			},
@@ -230,20 +274,7 @@ void OptionFields::write(mrpt::config::CConfigFileBase& c, const std::string& s)
 void OptionFields::validate(const std::string& s) const
 {
 	for (const auto& f : m_fields)
-	{
-		const bool ok = std::visit(
-			[&](const auto& m) {
-				using P = std::decay_t<decltype(m)>;
-				if constexpr (std::is_same_v<P, CustomOptionValue>)
-					return f.rule.accepts(m.format());
-				else if constexpr (std::is_same_v<P, std::string*>)
-					return f.rule.accepts(*m);
-				else
-					return f.rule.accepts(static_cast<double>(*m));
-			},
-			f.member);
-		if (!ok) throw std::invalid_argument("[" + s + "] " + f.key + " = " + f.valueText() + " (must be " + f.rule.text() + ")");
-	}
+		if (!f.accepted()) throw std::invalid_argument("[" + s + "] " + f.key + " = " + f.valueText() + " (must be " + f.rule.text() + ")");
 }
 
 }  // namespace keygrid::core

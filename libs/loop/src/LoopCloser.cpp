@@ -143,8 +143,7 @@ void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 	core::validateFields(*this, s);
 	// The vocabulary's size and the verification's other parameters.
 	ransac.validate(s);
-	std::string why;
-	if (!vocabularyOptions.isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
+	vocabularyOptions.validate(s);
 }
 
 void LoopClosingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const

@@ -12,41 +12,38 @@
 
 namespace keygrid::loop
 {
-bool VocabularyOptions::isValid(std::string* why) const
+core::OptionFields VocabularyOptions::fields()
 {
-	auto fail = [&](const std::string& s) {
-		if (why) *why = s;
-		return false;
-	};
-	if (branching < 2) return fail("branching = " + std::to_string(branching) + " (must be >= 2)");
-	if (levels < 1) return fail("levels = " + std::to_string(levels) + " (must be >= 1)");
+	using R = core::OptionRule;
+	core::OptionFields f(34);
+	f.add("branching", branching, "k: children per node", R::atLeast(2));
+	f.add("levels", levels, "L: depth of the tree (k^L words at most)", R::atLeast(1));
+	f.add("max_iterations", maxIterations, "Lloyd iterations per k-means", R::atLeast(1));
+	f.add("seed", seed, "k-means++ seed");
+	f.add("threads", threads, "training threads (0: all cores)", R::atLeast(0));
+	return f;
+}
+
+void VocabularyOptions::validate(const std::string& section) const
+{
+	core::validateFields(*this, section);
+	// Word and node ids are 32-bit.
+	constexpr double kMaxWords = 4.0e9;
 	double words = 1;
-	for (int l = 0; l < levels; ++l) words *= branching;
-	if (words > 4.0e9) return fail("branching^levels = " + std::to_string(words) + " (must be < 4e9 words)");
-	if (maxIterations < 1) return fail("max_iterations = " + std::to_string(maxIterations) + " (must be >= 1)");
-	if (threads < 0) return fail("threads = " + std::to_string(threads) + " (must be >= 0)");
-	return true;
+	for (int l = 0; l < levels && words <= kMaxWords; ++l) words *= branching;
+	if (words > kMaxWords)
+		throw std::invalid_argument(
+			"[" + section + "] branching = " + std::to_string(branching) + ", levels = " + std::to_string(levels) +
+			" (branching^levels words must be at most 4e9)");
 }
 
 void VocabularyOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
 {
-	branching = c.read_int(s, "branching", branching);
-	levels = c.read_int(s, "levels", levels);
-	maxIterations = c.read_int(s, "max_iterations", maxIterations);
-	seed = c.read_uint64_t(s, "seed", seed);
-	threads = c.read_int(s, "threads", threads);
-	std::string why;
-	if (!isValid(&why)) throw std::invalid_argument("[" + s + "] " + why);
+	fields().read(c, s);
+	validate(s);
 }
 
-void VocabularyOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	c.write(s, "branching", branching, 34, 40, "k: children per node");
-	c.write(s, "levels", levels, 34, 40, "L: depth of the tree (k^L words at most)");
-	c.write(s, "max_iterations", maxIterations, 34, 40, "Lloyd iterations per k-means");
-	c.write(s, "seed", seed, 34, 40, "k-means++ seed");
-	c.write(s, "threads", threads, 34, 40, "training threads (0: all cores)");
-}
+void VocabularyOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
 
 void Vocabulary::checkDescriptors(const cv::Mat& d) const
 {

@@ -292,8 +292,7 @@ class VocabularyBuilder
 Vocabulary Vocabulary::train(
 	const std::vector<cv::Mat>& imageDescriptors, const VocabularyOptions& opts, const Progress& progress)
 {
-	std::string why;
-	if (!opts.isValid(&why)) throw std::invalid_argument("VocabularyOptions: " + why);
+	opts.validate();
 	int type = -1, cols = 0;
 	std::size_t total = 0;
 	for (const auto& d : imageDescriptors)

@@ -31,8 +31,8 @@ core::OptionFields DepthIntegrationOptions::fields()
 	f.add("logOddsMiss", logOddsMiss, "log-odds added to the voxels a ray crosses before its end", detail::negative());
 	f.add("logOddsMin", logOddsMin, "lower clamp of a voxel's log-odds", detail::negative());
 	f.add("logOddsMax", logOddsMax, "upper clamp of a voxel's log-odds", R::positive());
-	f.addCustom(
-		"maxDenseMarkVoxels", detail::exactNumberValue(maxDenseMarkVoxels),
+	f.add(
+		"maxDenseMarkVoxels", maxDenseMarkVoxels,
 		"largest dense per-frame mark volume [voxels, 1 byte each] in [512, 1073741824]; larger frames take a slower sparse path");
 	f.addCustom(
 		"discretizeEndpoints", detail::flagValue(discretizeEndpoints),

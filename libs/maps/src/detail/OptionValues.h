@@ -73,24 +73,6 @@ void addWords(
 		description, core::OptionRule::oneOf(names));
 }
 
-/** A number written with all its digits: MRPT writes a double with 7 significant digits, which
- * would change large values such as 67108864 on a save and load. The field's range is the
- * struct's validate() to check. */
-inline core::CustomOptionValue exactNumberValue(double& number)
-{
-	return {
-		[&number](const std::string& text) {
-			double v = 0;
-			if (!core::parseTrimmedDouble(text, v)) throw std::invalid_argument("not a finite number");
-			number = v;
-		},
-		[&number] {
-			char b[32];
-			std::snprintf(b, sizeof(b), "%.17g", number);
-			return std::string(b);
-		}};
-}
-
 /** A vector written "x y z" (three numbers, nothing else). */
 inline core::CustomOptionValue vectorValue(mrpt::math::TVector3D& vec)
 {

@@ -30,7 +30,8 @@ core::CommandLine simCommandLine()
 		"DIR/occupancy_voxels.txt and DIR/floorplan.pgm/.yaml. With --augment TUM_DIR it\n"
 		"renders the scene's objects into a real TUM sequence at its ground-truth poses\n"
 		"instead (occlusion against the real depth; tum/mask/ marks the inserted pixels).\n"
-		"See doc/simulator.md.");
+		"--set 'output.sensor=monocular' writes the images alone (a rawlog of\n"
+		"CObservationImage, tum/ with rgb.txt only). See doc/simulator.md.");
 	cl.option("scene", "SCENE.ini", "scene description (e.g. config/sim/room_loop.ini)", true)
 		.option("output", "DIR", "output folder (created if needed)", true)
 		.option(

@@ -15,6 +15,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 namespace keygrid::slam
@@ -80,16 +81,29 @@ class DescriptorExtractor
 	cv::Ptr<cv::Feature2D> m_f;
 };
 
-/** Training options of the command line (--k, --levels, --seed, --threads), checked. */
+/** Training options of the command line (--k, --levels, --seed, --threads), checked by the
+ * rules of VocabularyOptions' INI keys; an error names the option as typed. */
 loop::VocabularyOptions vocabularyOptions(const core::CommandLine& cl)
 {
+	// The command-line option of each INI key the command line sets.
+	const std::map<std::string, std::string> optionOfKey{{"branching", "k"}, {"levels", "levels"}, {"seed", "seed"}, {"threads", "threads"}};
 	loop::VocabularyOptions vo;
 	vo.branching = static_cast<int>(cl.getInt("k"));
 	vo.levels = static_cast<int>(cl.getInt("levels"));
 	vo.seed = static_cast<std::uint64_t>(cl.getInt("seed"));
 	vo.threads = static_cast<int>(cl.getInt("threads"));
-	std::string why;
-	if (!vo.isValid(&why)) throw core::CommandLineError(why);
+	const core::OptionFields table = vo.fields();
+	for (const auto& f : table.fields())
+		if (const auto o = optionOfKey.find(f.key); o != optionOfKey.end() && !f.accepted())
+			throw core::CommandLineError("--" + o->second + " " + cl.get(o->second) + " (must be " + f.rule.text() + ")");
+	try
+	{
+		vo.validate("vocabulary");
+	}
+	catch (const std::invalid_argument& e)
+	{
+		throw core::CommandLineError(std::string("--k, --levels: ") + e.what());
+	}
 	return vo;
 }
 

@@ -4,7 +4,8 @@
  * its INI key, the member it sets, a one-line description (with the unit) and the values it
  * accepts. Reading is strict (ConfigReading.h): "12abc", "nan" or "maybe" throw
  * std::invalid_argument naming [section], key and value. Writing puts the description as the
- * comment, which is also the field's row in doc/ini-reference.md. validate() throws
+ * comment, which is also the field's row in doc/ini-reference.md; a float or double is written
+ * so that reading it back gives the same value bit for bit. validate() throws
  * std::invalid_argument("[section] key = value (must be <rule>)") for the first field whose
  * value breaks its rule; checks that relate two fields stay with the struct, after these.
  *
@@ -96,6 +97,8 @@ struct OptionField
 
 	/** The current value as text: numbers in their shortest exact form, text quoted. */
 	std::string valueText() const;
+	/** Whether `rule` accepts the current value. */
+	bool accepted() const;
 };
 
 class OptionFields
@@ -123,7 +126,9 @@ class OptionFields
 	 * field's type (whole numbers for integers, finite numbers, true/false/1/0). Rules are
 	 * validate()'s to check. */
 	void read(const mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
-	/** Writes every field with its description as comment, in table order. */
+	/** Writes every field with its description as comment, in table order. Numbers are written
+	 * as MRPT's write() prints them ("0.050000") when that text reads back as the same value,
+	 * else in their shortest text that does ("0.6666666666666666"). */
 	void write(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument("[section] key = value (must be <rule>)") for the first field
 	 * whose value its rule refuses. */

@@ -8,6 +8,7 @@
  * bit-majority centres) or CV_32F (e.g. SIFT 128 floats: Euclidean distance, mean centres).
  * The tree is built deterministically for a given seed, whatever the number of threads.
  */
+#include <keygrid/core/OptionFields.h>
 #include <keygrid/loop/BowVector.h>
 #include <opencv2/core.hpp>
 
@@ -43,9 +44,13 @@ struct VocabularyOptions
 	/** Worker threads for training; 0 = hardware concurrency. The tree does not depend on it (Default: 0) */
 	int threads{0};
 
-	/** Returns false and the offending key/value in *why when invalid. */
-	bool isValid(std::string* why = nullptr) const;
-	/** Reads keys branching, levels, max_iterations, seed, threads; throws naming an invalid key. */
+	/** The INI keys branching, levels, max_iterations, seed, threads, with description and rule
+	 * (core/OptionFields.h). */
+	core::OptionFields fields();
+	/** Throws std::invalid_argument("[section] key = value (must be ...)") on a bad value, and
+	 * for a tree of more than 4e9 words (word ids are 32-bit). */
+	void validate(const std::string& section = "vocabulary") const;
+	/** Reads the keys strictly and validates them; throws naming [section] and key. */
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 };
