@@ -1,4 +1,4 @@
-// Issue 29's acceptance test "metric scale from camera_height on a rendered scene": keygrid-sim's
+// Metric scale from camera_height on a rendered scene: keygrid-sim's
 // room_loop and office_loop scenes (config/sim) are rendered at their keyframes' ground-truth
 // poses, map points are taken where the rendered depth puts the scene's surfaces (one per 8 x 8
 // pixel cell of a 160 x 120 view with the Kinect's field of view, as a feature grid spreads

@@ -1,4 +1,4 @@
-// TwoViewInitializer (monocular map start, issue 29) against synthetic correspondences with a
+// TwoViewInitializer (monocular map start) against synthetic correspondences with a
 // known motion: points projected through a pinhole into a 640 x 480 image, Gaussian pixel noise
 // of std sigma in both views and a share of outliers (current pixel drawn uniformly).
 // Accuracy bounds come from the noise: the Cramer-Rao bound of the two-view problem (Fisher

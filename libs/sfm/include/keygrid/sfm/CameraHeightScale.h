@@ -1,6 +1,6 @@
 #pragma once
 /** \file CameraHeightScale.h
- * Metric scale of a monocular map from the camera's known height above the floor (issue 29):
+ * Metric scale of a monocular map from the camera's known height above the floor:
  * the floor plane is estimated among the map points below the keyframe cameras, each
  * keyframe's height above it is measured in map units, and
  *
