@@ -305,13 +305,7 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	const int withDepth = static_cast<int>(std::count_if(cur.features.depth.begin(), cur.features.depth.end(), [](float d) { return d > 0; }));
 	if (withDepth < m_opts.minInitFeatures) return false;
 	cur.T_world_cam = mrpt::poses::CPose3D();  // the first keyframe defines the world frame
-	KeyFrame kf;
-	kf.frameIndex = cur.frame->index;
-	kf.timestamp = cur.frame->timestamp;
-	kf.T_world_cam = cur.T_world_cam;
-	kf.features = cur.features;
-	kf.depth = cur.frame->depth;
-	kf.colour = (cur.frame->colour.empty() ? cur.frame->grey : cur.frame->colour).clone();
+	KeyFrame kf = keyFrameOf(cur);
 	kf.mapId = m_newMapId;
 	const KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;
 	const auto& f = m_map.keyframe(id).features;
@@ -587,7 +581,7 @@ bool Tracker::needKeyFrame(const Current& cur) const
 	return (timeout || weak) && cur.inliers > kMinKeyFrameInliers;
 }
 
-KeyFrameId Tracker::createKeyFrame(const Current& cur)
+KeyFrame Tracker::keyFrameOf(const Current& cur)
 {
 	KeyFrame kf;
 	kf.frameIndex = cur.frame->index;
@@ -596,6 +590,12 @@ KeyFrameId Tracker::createKeyFrame(const Current& cur)
 	kf.features = cur.features;
 	kf.depth = cur.frame->depth;
 	kf.colour = (cur.frame->colour.empty() ? cur.frame->grey : cur.frame->colour).clone();
+	return kf;
+}
+
+KeyFrameId Tracker::createKeyFrame(const Current& cur)
+{
+	KeyFrame kf = keyFrameOf(cur);
 	kf.parent = m_refKf;
 	kf.hasParent = m_map.hasKeyFrame(m_refKf);
 	kf.mapId = kf.hasParent ? m_map.keyframe(m_refKf).mapId : m_newMapId;

@@ -188,6 +188,8 @@ class Tracker
 	void updateHoc(Current& cur, TrackedFrame& out);
 	bool needKeyFrame(const Current& cur) const;
 	KeyFrameId createKeyFrame(const Current& cur);
+	/** A keyframe of the current frame: its time, pose, features, depth and colour image. */
+	static KeyFrame keyFrameOf(const Current& cur);
 
 	SparseMap& m_map;
 	TrackerOptions m_opts;
