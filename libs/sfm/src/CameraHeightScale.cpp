@@ -71,8 +71,9 @@ namespace
 /** Plane searches at most. */
 constexpr int kMaxPasses = 4;
 /** The scale has settled when a search's result is within this share of the scale its
- * tolerances were set with: 1 % of a 5 cm band is 0.5 mm, while the points that noise moves
- * in or out of the band make successive searches on a noisy map differ by about that much. */
+ * tolerances were set with: a fraction of the inlier band small next to the differences
+ * between successive searches on a noisy map, which the points that noise moves in or out of
+ * the band cause. */
 constexpr double kSettled = 0.01;
 /** First estimate of h_map: this quantile of the points' depth below their nearest camera. The
  * floor is the lowest surface, so the upper tail of that depth is the camera height; a high

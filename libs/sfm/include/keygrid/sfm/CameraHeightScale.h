@@ -69,9 +69,9 @@ struct CameraHeightScaleOptions
 	double minDepressionDeg{5.0};
 	/** Point-to-plane distance of a floor inlier [m]. A map point errs mostly along its ray,
 	 * with a depth std d^2 sigma_px / (f B) over a baseline B, so a floor point seen from height
-	 * h at distance d has a height std of h / d of that: 1.2 .. 2 cm at 2.5 m from a camera at
-	 * 1.3 m for 1 px at f = 525 px and B = 0.5 .. 0.3 m (points refined by local bundle
-	 * adjustment); the band holds 2.5 .. 4 of those. The RGB-D floor uses 2 cm (Default: 0.05 m) */
+	 * h at distance d has a height std of h / d of that; the band holds a few of those for
+	 * points refined by local bundle adjustment, so it is wider than the RGB-D floor's
+	 * (doc/frontend.md, "Metric scale from the camera height") (Default: 0.05 m) */
 	double inlierDistance{0.05};
 	/** A point this far under a plane is below it; a plane with many points below is not the
 	 * floor. Far enough that the floor's own noise does not count against it [m]
