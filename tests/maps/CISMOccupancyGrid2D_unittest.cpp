@@ -152,7 +152,7 @@ TEST(CISMOccupancyGrid2D, OptionsSaveLoadRoundTripAndErrorsNameTheKey)
 	a.rayTraversal = CISMOccupancyGrid2D::RayTraversal::AntiAliased;
 	a.T_world_floor = mrpt::poses::CPose3D(1, 2, 3, 0.1, 0.2, 0.3);
 	a.floorRansac.iterations = 77;
-	a.floorUpHint = mrpt::math::TVector3D(0, 0.5, 1);
+	a.floorUpHint = mrpt::math::TVector3D(0, 0.5, 1.0 / 3.0);  // 1/3 is written exactly too
 	a.estimateFloorFromDepth = true;
 	a.freeSpaceModel = CISMOccupancyGrid2D::FreeSpaceModel::Paper;
 	mrpt::config::CConfigFileMemory saved;
@@ -167,7 +167,8 @@ TEST(CISMOccupancyGrid2D, OptionsSaveLoadRoundTripAndErrorsNameTheKey)
 	EXPECT_EQ(b.rayTraversal, CISMOccupancyGrid2D::RayTraversal::AntiAliased);
 	EXPECT_EQ(b.floorRansac.iterations, 77);
 	EXPECT_NEAR((b.T_world_floor - a.T_world_floor).translation().norm(), 0.0, 1e-6);
-	EXPECT_DOUBLE_EQ(b.floorUpHint.y, 0.5);
+	EXPECT_EQ(b.floorUpHint.y, 0.5);
+	EXPECT_EQ(b.floorUpHint.z, 1.0 / 3.0);
 	EXPECT_TRUE(b.estimateFloorFromDepth);
 	EXPECT_EQ(b.freeSpaceModel, CISMOccupancyGrid2D::FreeSpaceModel::Paper);
 

@@ -87,3 +87,23 @@ TEST(SparseMap, ResolveFollowsFusionsToTheSurvivingLandmark)
 	EXPECT_EQ(m.resolve(l0), kNoLandmark);
 	EXPECT_EQ(m.resolve(12345), kNoLandmark);
 }
+
+TEST(SparseMap, ResolvedLandmarksTableAgreesWithResolve)
+{
+	SparseMap m;
+	const auto a = m.addKeyFrame(makeKf(CPose3D(), 10)).id;
+	std::vector<LandmarkId> ids;
+	for (int i = 0; i < 8; i++) ids.push_back(m.addLandmark({0.1 * i, 0, 2}, a, i));
+	m.replaceLandmark(ids[0], ids[1]);
+	m.replaceLandmark(ids[1], ids[5]);  // 0 -> 1 -> 5
+	m.replaceLandmark(ids[2], ids[3]);
+	m.eraseLandmark(ids[3]);  // 2 -> 3, erased
+	m.eraseLandmark(ids[6]);
+	const auto table = m.resolvedLandmarks();
+	ASSERT_EQ(table.size(), ids.size());
+	for (const LandmarkId id : ids) EXPECT_EQ(table[id], m.findLandmark(m.resolve(id))) << "landmark " << id;
+	EXPECT_EQ(table[ids[0]], &m.landmark(ids[5]));
+	EXPECT_EQ(table[ids[2]], nullptr);
+	EXPECT_EQ(table[ids[6]], nullptr);
+	EXPECT_EQ(table[ids[7]], &m.landmark(ids[7]));
+}

@@ -31,3 +31,82 @@ TEST(FinalRefinement, DisplacementCountsTheCentreAndThePointAheadOfTheCamera)
 	// Keyframes absent from `after` (erased) do not count.
 	EXPECT_EQ(slam::largestDisplacement(before, {{7, CPose3D(1, 0, 0, 0, 0, 0)}}, 4.0), 0.0);
 }
+
+namespace
+{
+/** A map of 60 landmarks on a 3 m wide wall 4 m ahead, one keyframe observing them all. */
+void fillWallMap(sfm::SparseMap& map, std::vector<sfm::LandmarkId>& ids)
+{
+	constexpr int n = 60;
+	sfm::KeyFrame kf;
+	kf.features.keypoints.resize(n);
+	kf.features.undistorted.resize(n);
+	kf.features.depth.assign(n, 4.f);
+	kf.features.descriptors = cv::Mat(n, 32, CV_8U, cv::Scalar(0));
+	kf.features.levelScale = {1.0};
+	const auto k = map.addKeyFrame(kf).id;
+	for (int i = 0; i < n; i++)
+		ids.push_back(map.addLandmark({-1.5 + 0.3 * (i % 10), -1.0 + 0.4 * (i / 10), 4.0 + 0.1 * (i % 3)}, k, i));
+}
+
+/** A tracked frame at `truth` observing `ids` (pixels and depths exact). */
+sfm::TrackedFrame frameSeeing(
+	const sfm::SparseMap& map, const std::vector<sfm::LandmarkId>& ids, const CPose3D& truth, const sfm::PinholeIntrinsics& K)
+{
+	sfm::TrackedFrame f;
+	f.tracked = true;
+	for (const auto id : ids)
+	{
+		mrpt::math::TPoint3D pc;
+		const auto& p = map.landmark(id).p_world;
+		truth.inverseComposePoint(p.x(), p.y(), p.z(), pc.x, pc.y, pc.z);
+		sfm::FrameObservation o;
+		o.u = static_cast<float>(K.fx * pc.x / pc.z + K.cx);
+		o.v = static_cast<float>(K.fy * pc.y / pc.z + K.cy);
+		o.depth = static_cast<float>(pc.z);
+		f.observedLandmarks.push_back(id);
+		f.observations.push_back(o);
+	}
+	return f;
+}
+}  // namespace
+
+TEST(FinalRefinement, FramesConvergeToTheirPoseThroughFusedLandmarksAndTooFewKeepNone)
+{
+	std::vector<sfm::LandmarkId> ids;
+	sfm::SparseMap map;
+	fillWallMap(map, ids);
+	const sfm::PinholeIntrinsics K;
+	const CPose3D truth(0.1, -0.05, 0.2, 0.03, -0.02, 0.01);
+	// Frame 1 sees 16 landmarks, frame 2 15; all three matched ids[0], since fused into ids[1]
+	// and moved to ids[0]'s place: ids[0]'s observations still count, through the survivor,
+	// and ids[1]'s own observations are now outliers (30 cm off) that the rounds must drop.
+	std::vector<sfm::TrackedFrame> frames(3, frameSeeing(map, ids, truth, K));
+	for (std::size_t i = 1; i < 3; i++)
+	{
+		frames[i].observedLandmarks.resize(17 - i);
+		frames[i].observations.resize(17 - i);
+	}
+	map.landmark(ids[1]).p_world = map.landmark(ids[0]).p_world;
+	map.replaceLandmark(ids[0], ids[1]);
+	const CPose3D start(0.12, -0.04, 0.17, 0.04, -0.02, 0.0);
+	const core::Trajectory base(3, {0.0, start});
+	// (One round cannot: it solves with every observation and only classifies afterwards.)
+	for (const int rounds : {2, 4})
+	{
+		sfm::PoseOptimizerOptions pose;
+		pose.rounds = rounds;
+		const auto refined = slam::refineFramePoses(frames, base, map, K, pose, 15, [](const sfm::TrackedFrame&) { return true; });
+		ASSERT_EQ(refined.size(), 3u);
+		for (std::size_t i = 0; i < 2; i++)
+		{
+			ASSERT_TRUE(refined[i].has_value()) << "frame " << i << ", " << rounds << " rounds";
+			// Exact pixels (to float rounding): the pose is recovered to well under a millimetre.
+			EXPECT_LT((refined[i]->asVectorVal() - truth.asVectorVal()).norm(), 1e-4) << "frame " << i << ", " << rounds << " rounds";
+		}
+		EXPECT_FALSE(refined[2].has_value()) << "14 inliers, fewer than minInliers = 15";
+	}
+	// A frame `select` refuses keeps none.
+	const auto none = slam::refineFramePoses(frames, base, map, K, {}, 15, [](const sfm::TrackedFrame&) { return false; });
+	EXPECT_FALSE(none[0].has_value());
+}

@@ -159,6 +159,8 @@ bool OptionRule::accepts(const std::string& v) const
 	return false;
 }
 
+std::string shortestNumberText(double v) { return shortestText(v); }
+
 std::string OptionRule::text() const
 {
 	switch (m_kind)

@@ -170,6 +170,16 @@ LandmarkId SparseMap::resolve(LandmarkId id) const
 	return hasLandmark(id) ? id : kNoLandmark;
 }
 
+std::vector<const Landmark*> SparseMap::resolvedLandmarks() const
+{
+	// A restored map may hold fused ids above every landmark's.
+	const LandmarkId size = m_replacedBy.empty() ? m_nextLm : std::max(m_nextLm, m_replacedBy.rbegin()->first + 1);
+	std::vector<const Landmark*> table(static_cast<std::size_t>(size), nullptr);
+	for (const auto& [id, lm] : m_landmarks) table[static_cast<std::size_t>(id)] = &lm;
+	for (const auto& [gone, keep] : m_replacedBy) table[static_cast<std::size_t>(gone)] = findLandmark(resolve(gone));
+	return table;
+}
+
 void SparseMap::updateLandmarkStats(LandmarkId id)
 {
 	auto& l = m_landmarks.at(id);

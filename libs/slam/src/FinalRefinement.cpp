@@ -59,10 +59,15 @@ double largestDisplacement(
 
 std::vector<std::optional<mrpt::poses::CPose3D>> refineFramePoses(
 	const std::vector<sfm::TrackedFrame>& frames, const core::Trajectory& base, const sfm::SparseMap& map,
-	const sfm::PinholeIntrinsics& K, const sfm::TrackerOptions& tracker,
+	const sfm::PinholeIntrinsics& K, const sfm::PoseOptimizerOptions& pose, int minInliers,
 	const std::function<bool(const sfm::TrackedFrame&)>& select)
 {
 	std::vector<std::optional<mrpt::poses::CPose3D>> refined(frames.size());
+	// A landmark fused into another since the frame matched it: the survivor stands for it.
+	const std::vector<const sfm::Landmark*> landmarks = map.resolvedLandmarks();
+	const auto landmarkOf = [&](sfm::LandmarkId id) -> const sfm::Landmark* {
+		return id < landmarks.size() ? landmarks[static_cast<std::size_t>(id)] : nullptr;
+	};
 	const auto refine = [&](std::size_t first)
 	{
 		for (std::size_t i = first; i < frames.size(); i += 2)
@@ -73,15 +78,14 @@ std::vector<std::optional<mrpt::poses::CPose3D>> refineFramePoses(
 			obs.reserve(f.observations.size());
 			for (std::size_t k = 0; k < f.observations.size(); k++)
 			{
-				// A landmark fused into another since the frame matched it: use the survivor.
-				const sfm::Landmark* lm = map.findLandmark(map.resolve(f.observedLandmarks[k]));
+				const sfm::Landmark* lm = landmarkOf(f.observedLandmarks[k]);
 				if (!lm) continue;
 				obs.push_back(f.observations[k].toPoseObservation(lm->p_world));
 			}
-			if (static_cast<int>(obs.size()) < tracker.minInliers) continue;
+			if (static_cast<int>(obs.size()) < minInliers) continue;
 			auto T = base[i].T_world_cam;
-			const auto r = sfm::optimizePose(T, obs, K, tracker.pose);
-			if (r.inliers >= tracker.minInliers) refined[i] = T;
+			const auto r = sfm::optimizePose(T, obs, K, pose);
+			if (r.inliers >= minInliers) refined[i] = T;
 		}
 	};
 	// std::async's future joins in its destructor and passes an exception on through get().

@@ -26,6 +26,7 @@ core::OptionFields RefinementOptions::fields()
 	f.add("global_iterations", globalIterations, "upper bound on its iterations (it stops on convergence)", R::atLeast(1));
 	f.add("global_max_keyframes", globalMaxKeyFrames, "keyframes it moves at most: around the loops and the newest (0 = all)", R::atLeast(0));
 	f.add("refine_frames", refineFrames, "re-estimate every frame that is not a keyframe against the final map");
+	f.add("frame_pose_rounds", framePoseRounds, "outlier-classification rounds of each frame's re-estimation", R::atLeast(1));
 	f.add("map_reanchor_min_shift", mapReanchorMinShift, "re-anchor the maps only if a keyframe moved more than this [m]", R::atLeast(0));
 	f.add("map_reanchor_depth", mapReanchorDepth, "...measured also at this depth ahead of the camera [m]", R::atLeast(0));
 	return f;

@@ -514,8 +514,10 @@ void System::refineFrames(const std::optional<std::set<sfm::KeyFrameId>>& window
 	if (!m_cfg.refinement.refineFrames) return;
 	const auto t0 = std::chrono::steady_clock::now();
 	const sfm::SparseMap& map = m_map;
+	auto pose = m_cfg.tracker.pose;
+	pose.rounds = m_cfg.refinement.framePoseRounds;
 	m_refined = refineFramePoses(
-		m_frames, trajectory(), m_map, *m_K, m_cfg.tracker,
+		m_frames, trajectory(), m_map, *m_K, pose, m_cfg.tracker.minInliers,
 		[&](const sfm::TrackedFrame& f)
 		{
 			// A keyframe keeps its pose from the (global) bundle adjustment: that joint estimate

@@ -10,7 +10,6 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -73,7 +72,7 @@ void addWords(
 		description, core::OptionRule::oneOf(names));
 }
 
-/** A vector written "x y z" (three numbers, nothing else). */
+/** A vector written "x y z" (three numbers, nothing else; each written exactly). */
 inline core::CustomOptionValue vectorValue(mrpt::math::TVector3D& vec)
 {
 	return {
@@ -84,9 +83,8 @@ inline core::CustomOptionValue vectorValue(mrpt::math::TVector3D& vec)
 			vec = mrpt::math::TVector3D(x, y, z);
 		},
 		[&vec] {
-			char b[96];
-			std::snprintf(b, sizeof(b), "%g %g %g", vec.x, vec.y, vec.z);
-			return std::string(b);
+			return core::shortestNumberText(vec.x) + " " + core::shortestNumberText(vec.y) + " " +
+				core::shortestNumberText(vec.z);
 		}};
 }
 

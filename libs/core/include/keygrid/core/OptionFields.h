@@ -77,6 +77,10 @@ class OptionRule
 	std::vector<std::string> m_words;
 };
 
+/** A number in the shortest text that reads back as the same double: whole numbers without
+ * exponent ("3"), others in the shortest "%g" form that round-trips ("0.1", "0.6666666666666666"). */
+std::string shortestNumberText(double v);
+
 /** A field whose INI text is parsed and formatted by the struct itself (lists, poses, enums):
  * `parse` throws std::invalid_argument with the reason ("expected x y z") when the text is not
  * a valid value, `format` gives the text written for the current value. */

@@ -102,6 +102,11 @@ class SparseMap
 	 * (following later fusions too); kNoLandmark if that one was erased. Frames keep the ids
 	 * they matched; this maps them onto the current map. */
 	LandmarkId resolve(LandmarkId id) const;
+	/** resolve() and findLandmark() of every id issued so far, as a table indexed by id:
+	 * entry i is the landmark that now stands for landmark i, nullptr when there is none. One
+	 * pass over the map, for callers that resolve many ids (a lookup each costs more); valid
+	 * until the map changes. */
+	std::vector<const Landmark*> resolvedLandmarks() const;
 
 	/** Recomputes normal, distance limits and representative descriptor of a landmark. */
 	void updateLandmarkStats(LandmarkId lm);

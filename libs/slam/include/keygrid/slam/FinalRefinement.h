@@ -47,12 +47,13 @@ double largestDisplacement(
 
 /** Re-estimates the pose of every tracked frame that `select` accepts against the landmarks
  * now in `map` (each starting from `base`, its pose before), from the inlier observations it
- * kept; a frame keeps no re-estimate (nullopt) when fewer than minInliers observations remain
- * or are inliers. Frames are independent: two workers (every other frame each) read the map
- * and write their own entries, so the result does not depend on scheduling. */
+ * kept, with the pose solver's options `pose`; a frame keeps no re-estimate (nullopt) when
+ * fewer than minInliers observations remain or are inliers. Frames are independent: two
+ * workers (every other frame each) read the map and write their own entries, so the result
+ * does not depend on scheduling. */
 std::vector<std::optional<mrpt::poses::CPose3D>> refineFramePoses(
 	const std::vector<sfm::TrackedFrame>& frames, const core::Trajectory& base, const sfm::SparseMap& map,
-	const sfm::PinholeIntrinsics& K, const sfm::TrackerOptions& tracker,
+	const sfm::PinholeIntrinsics& K, const sfm::PoseOptimizerOptions& pose, int minInliers,
 	const std::function<bool(const sfm::TrackedFrame&)>& select);
 
 }  // namespace keygrid::slam

@@ -42,6 +42,11 @@ struct RefinementOptions
 	 * bundle adjustment of every keyframe, the frames whose reference keyframe it moved after a
 	 * bounded one (Default: true) */
 	bool refineFrames{true};
+	/** Outlier-classification rounds of each frame's re-estimation ([tracker] pose rounds has
+	 * the tracker's). Each frame starts from its tracked pose with the observations tracking
+	 * kept as inliers, so the classification rounds a rough start needs have little left to do
+	 * (doc/evaluation.md, "Final step") (Default: 2) */
+	int framePoseRounds{2};
 	/** The maps are re-anchored on the refined keyframe poses only when the refinement moved a
 	 * keyframe's camera centre, or the point map_reanchor_depth ahead of it, by more than this;
 	 * a rebuild of the 2D grid and a morph of the 3D grid cost as much as the whole map.
