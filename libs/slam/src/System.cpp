@@ -142,6 +142,16 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	sfm::TrackedFrame tf = m_tracker.track(frame, std::move(features));
 	m_timings.add("track", secondsSince(t0));
 	if (m_cfg.tracker.hoc.enabled) m_timings.add("hoc", tf.hocSeconds);
+	if (!tf.initMessage.empty()) logInitialization(tf);
+	// Monocular map start: the first keyframe (the reference frame, at the origin) is mapped
+	// before the second, and the path starts there.
+	std::optional<KeyFrameJob> initialJob;
+	if (tf.hasInitialKeyFrame)
+	{
+		initialJob = KeyFrameJob{tf.initialKeyFrame, tf.initialFrameIndex, m_travelled, K};
+		m_lastTrackedPose = m_map.keyframe(tf.initialKeyFrame).T_world_cam;
+		attachInitialKeyFrame(tf);
+	}
 	// A loop closed on another thread moved the map: the path length restarts from here.
 	if (m_map.corrections() != m_correctionsSeen)
 	{
@@ -156,6 +166,11 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	const KeyFrameJob job{tf.keyframe, tf.index, m_travelled, K};
 	if (tf.newKeyFrame && !m_mappingQueue)
 	{
+		if (initialJob)
+		{
+			mapKeyFrame(*initialJob);
+			insertAndCloseLoops(*initialJob, nullptr);
+		}
 		mapKeyFrame(job);
 		insertAndCloseLoops(job, &tf);
 	}
@@ -178,9 +193,19 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 			m_stats.lost++;
 		if (tf.method == sfm::TrackingMethod::Relocalization && tf.tracked) m_stats.relocalizations++;
 		if (tf.method == sfm::TrackingMethod::Pnp && tf.tracked) m_stats.pnpFallbacks++;
+		if (tf.hasInitialKeyFrame)
+		{
+			m_stats.framesToInitialize = m_stats.frames;
+			m_stats.initializationFrame = tf.index;
+		}
 	}
 	const bool queueKeyFrame = tf.newKeyFrame && m_mappingQueue;
 	m_frames.push_back(std::move(tf));
+	if (queueKeyFrame && initialJob)
+	{
+		if (!m_mappingQueue->push(*initialJob)) throwIfBackgroundFailed();
+		m_jobsQueued++;
+	}
 	if (queueKeyFrame)
 	{
 		if (!m_mappingQueue->push(job)) throwIfBackgroundFailed();
@@ -188,6 +213,38 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		waitForMapping();
 	}
 	return m_frames.back();
+}
+
+void System::logInitialization(const sfm::TrackedFrame& tf)
+{
+	// Every change of reference and the start are logged; repeated failures with one
+	// reference once per kEvery frames, and no more than kMaxLines lines in all.
+	constexpr std::size_t kEvery = 10, kMaxLines = 500;
+	const bool always = tf.hasInitialKeyFrame || tf.initNewReference;
+	const bool due = m_initLog.empty() || tf.index >= m_initLogLastFrame + kEvery;
+	if (m_initLog.size() >= kMaxLines || !(always || due))
+	{
+		++m_initLogSkipped;
+		return;
+	}
+	std::string line = tf.initMessage;
+	if (m_initLogSkipped) line += " [" + std::to_string(m_initLogSkipped) + " messages left out before]";
+	m_initLog.push_back(std::move(line));
+	m_initLogLastFrame = tf.index;
+	m_initLogSkipped = 0;
+}
+
+void System::attachInitialKeyFrame(const sfm::TrackedFrame& tf)
+{
+	for (auto it = m_frames.rbegin(); it != m_frames.rend(); ++it)
+	{
+		if (it->index != tf.initialFrameIndex) continue;
+		it->hasReference = true;
+		it->reference = tf.initialKeyFrame;
+		it->T_ref_cam = mrpt::poses::CPose3D();
+		it->T_world_cam = m_map.keyframe(tf.initialKeyFrame).T_world_cam;
+		return;
+	}
 }
 
 void System::mapKeyFrame(const KeyFrameJob& job)

@@ -53,6 +53,10 @@ struct SystemStats
 	std::size_t baDiscarded{0};
 	/** Extend mode: a map started apart from the loaded one merged into it by loop closing. */
 	std::size_t mapsMerged{0};
+	/** Monocular: frames processed until the map started, the frame that started it included
+	 * (0 while it has not started), and the index of that frame. */
+	std::size_t framesToInitialize{0};
+	std::size_t initializationFrame{0};
 };
 
 class System
@@ -134,6 +138,9 @@ class System
 	/** Keyframes in the map now (takes the map lock: safe while the threads run). */
 	std::size_t numKeyFrames() const;
 	const std::vector<sfm::TrackedFrame>& frames() const { return m_frames; }
+	/** Monocular: what the frames before the map start did (reference frames, why two-view
+	 * initialization failed, the start), at a bounded rate (slam.log). */
+	const std::vector<std::string>& initializationLog() const { return m_initLog; }
 	/** A snapshot of the counters (several threads update them in threaded mode). */
 	SystemStats stats() const;
 	/** In threaded mode only after finish(). */
@@ -174,6 +181,10 @@ class System
 	bool mapKeyFrameConcurrently(const KeyFrameJob& job);
 	/** The counters and timings of one keyframe's local mapping. */
 	void recordLocalMapping(const sfm::LocalMappingReport& rep, double seconds);
+	/** Monocular: a tracker's initialization message into m_initLog, at a bounded rate. */
+	void logInitialization(const sfm::TrackedFrame& tf);
+	/** Monocular map start: the frame that became the first keyframe references it now. */
+	void attachInitialKeyFrame(const sfm::TrackedFrame& tf);
 	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
 	 * tracker's last frame, which created the keyframe. */
 	void insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
@@ -236,6 +247,9 @@ class System
 	sfm::Tracker m_tracker;
 	sfm::LocalMapper m_mapper;
 	std::vector<sfm::TrackedFrame> m_frames;
+	std::vector<std::string> m_initLog;  //!< see initializationLog()
+	std::size_t m_initLogLastFrame{0};  //!< frame of the last line of m_initLog
+	std::size_t m_initLogSkipped{0};  //!< messages left out since then
 	std::vector<std::optional<mrpt::poses::CPose3D>> m_refined;
 	std::optional<sfm::PinholeIntrinsics> m_K;
 	bool m_finished{false};
