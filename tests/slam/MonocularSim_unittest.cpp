@@ -1,0 +1,54 @@
+// keygrid-slam in monocular mode end to end: keygrid-sim renders the test scene room_arc as a
+// plain camera's sequence (CObservationImage rawlog, `output.sensor=monocular`), keygrid-slam
+// runs the shipped config/sim_monocular.ini on it, and the trajectory is scored against the
+// simulator's exact ground truth after a Sim(3) alignment (a monocular map has no scale).
+#include <keygrid/core/TumTrajectory.h>
+#include <keygrid/slam/apps/SlamApp.h>
+#include <mrpt/system/filesystem.h>
+
+#include "SimSlamRun.h"
+#include "TestData.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+using namespace keygrid;
+
+TEST(MonocularSim, StartsFromTwoViewsAndTracksARenderedSequenceWithinOnePercentOfItsPath)
+{
+	const std::string dir = test::scratchDir("monocular_sim");
+	const auto run = test::renderAndRunSlam(
+		dir, "--scene " + test::dataDir() + "/sim/room_arc.ini --set 'output.sensor=monocular' --voxel-resolution 0 --floorplan-resolution 0",
+		true, "config/sim_monocular.ini");
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	const auto& o = run.options;
+	const auto& r = run.result;
+	ASSERT_TRUE(r.error.empty()) << r.error;
+	EXPECT_EQ(r.frames, 90u);
+
+	const auto report = nlohmann::json::parse(test::readTextFile(o.output + "/report.json"));
+	EXPECT_EQ(report.at("sensor"), "monocular");
+	EXPECT_EQ(report.at("scale_source"), "none");
+	EXPECT_EQ(report.at("ate_alignment"), "sim3");
+	ASSERT_TRUE(report.at("initialization").at("started").get<bool>());
+	const auto startFrame = report.at("initialization").at("frame").get<std::size_t>();
+	// The camera starts facing a wall (a plane: the homography's two motions stay ambiguous)
+	// and starts the map once the box beside it gives depth structure, about frame 35.
+	EXPECT_LT(startFrame, 45u);
+	// Every frame after the start is tracked.
+	EXPECT_EQ(r.tracked, r.frames - startFrame);
+	const std::string log = test::readTextFile(o.output + "/slam.log");
+	EXPECT_NE(log.find("map started"), std::string::npos) << log;
+
+	// trajectory.txt holds the frames from the reference frame (the first keyframe) on; the
+	// ATE after a Sim(3) alignment is below 1 % of the path they travel (the target).
+	const auto est = core::readTumTrajectory(o.output + "/trajectory.txt");
+	const auto gt = core::readTumTrajectory(dir + "/seq/groundtruth.txt");
+	ASSERT_GE(est.size(), r.frames - startFrame);
+	double travelled = 0;
+	for (std::size_t i = 1; i < gt.size(); i++)
+		if (gt[i - 1].t >= est.front().t - 1e-6)
+			travelled += (gt[i].T_world_cam.translation() - gt[i - 1].T_world_cam.translation()).norm();
+	ASSERT_TRUE(r.ateRmse.has_value());
+	EXPECT_LT(*r.ateRmse, 0.01 * travelled) << "path " << travelled << " m";
+}
