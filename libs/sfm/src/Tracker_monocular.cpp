@@ -212,6 +212,19 @@ bool Tracker::startMonocularMap(Current& cur, const TwoViewResult& r, const std:
 	return true;
 }
 
+void Tracker::onMapRescaled(double s)
+{
+	const auto scaled = [s](mrpt::poses::CPose3D T) {
+		T.x(s * T.x());
+		T.y(s * T.y());
+		T.z(s * T.z());
+		return T;
+	};
+	m_lastPose = scaled(m_lastPose);
+	if (m_velocity) m_velocity = scaled(*m_velocity);
+	if (m_lastRelative) m_lastRelative->second = scaled(m_lastRelative->second);
+}
+
 bool Tracker::needKeyFrameMonocular(const Current& cur) const
 {
 	const auto& mo = m_opts.mono;

@@ -86,6 +86,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	floor.loadFromConfigFile(c, "floor");
 	loop.loadFromConfigFile(c, "loop_closing");
 	store.loadFromConfigFile(c, "store");
+	metricScale.loadFromConfigFile(c, "camera_height_scale");
 	// The depth residual model is shared by tracking and bundle adjustment.
 	mapping.ba.bf = tracker.pose.bf;
 	mapping.ba.disparitySigma = tracker.pose.disparitySigma;
@@ -107,6 +108,7 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	floor.saveToConfigFile(c, "floor");
 	loop.saveToConfigFile(c, "loop_closing");
 	store.saveToConfigFile(c, "store");
+	metricScale.saveToConfigFile(c, "camera_height_scale");
 }
 
 namespace

@@ -27,6 +27,7 @@ System::System(const SlamConfig& cfg)
 	  m_mapper(m_map, cfg.mapping, cfg.tracker.matcher),
 	  m_images(std::make_unique<KeyFrameImageCache>(static_cast<std::size_t>(cfg.store.imageCacheMib) << 20))
 {
+	if (cfg.sensor == Sensor::Monocular && cfg.metricScale.enabled()) m_metricScale.emplace(cfg.metricScale);
 	if (cfg.loop.enabled)
 	{
 		m_loopCloser = std::make_unique<loop::LoopCloser>(m_map, m_mapper, cfg.loop, cfg.tracker.matcher, cfg.features.type);
@@ -175,6 +176,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		insertAndCloseLoops(job, &tf);
 	}
 	if (m_extending && !m_startedInStoredMap && !m_startedNewMap) startExtending(tf);
+	if (m_metricScale && tf.newKeyFrame) applyMetricScale(tf);
 	tf.mapLandmarks = m_map.numLandmarks();
 	lock.unlock();
 	{
@@ -232,6 +234,32 @@ void System::logInitialization(const sfm::TrackedFrame& tf)
 	m_initLog.push_back(std::move(line));
 	m_initLogLastFrame = tf.index;
 	m_initLogSkipped = 0;
+}
+
+void System::applyMetricScale(sfm::TrackedFrame& tf)
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	const auto s = m_metricScale->update(m_map);
+	m_timings.add("metric_scale", secondsSince(t0));
+	if (!s) return;
+	// A bundle adjustment solved meanwhile (threaded mode) was solved at the old scale.
+	m_map.noteCorrection();
+	m_correctionsSeen = m_map.corrections();
+	m_tracker.onMapRescaled(*s);
+	const auto scaled = [f = *s](mrpt::poses::CPose3D& T) {
+		T.x(f * T.x());
+		T.y(f * T.y());
+		T.z(f * T.z());
+	};
+	scaled(tf.T_world_cam);
+	scaled(tf.T_ref_cam);
+	for (auto& f : m_frames)
+	{
+		scaled(f.T_world_cam);
+		scaled(f.T_ref_cam);
+	}
+	m_travelled *= *s;
+	if (m_lastTrackedPose) scaled(*m_lastTrackedPose);
 }
 
 void System::attachInitialKeyFrame(const sfm::TrackedFrame& tf)

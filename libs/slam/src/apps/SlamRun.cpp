@@ -270,16 +270,18 @@ void writeOutputFiles(System& sys, const SlamConfig& cfg, const FinalTrajectory&
 }
 
 /** ATE and RPE of the final trajectory against --gt (at least three poses), after a Sim(3)
- * alignment for a monocular run; a failed evaluation becomes the run's error when it has none. */
+ * alignment for a map without metric units; a failed evaluation becomes the run's error when it
+ * has none. */
 std::optional<eval::TrajectoryErrors> evaluateAgainstGroundTruth(
-	const std::optional<core::Trajectory>& gt, const core::Trajectory& traj, Sensor sensor, SlamRunResult& res)
+	const std::optional<core::Trajectory>& gt, const core::Trajectory& traj, bool metricUnits, SlamRunResult& res)
 {
 	if (!gt || traj.size() < 3) return std::nullopt;
 	try
 	{
-		// A monocular trajectory has the map's arbitrary scale: aligned with a Sim(3).
+		// A monocular trajectory without metric scale has the map's arbitrary unit: aligned
+		// with a Sim(3).
 		eval::TrajectoryErrorOptions eo;
-		eo.withScale = sensor == Sensor::Monocular;
+		eo.withScale = !metricUnits;
 		auto errs = eval::evaluateTrajectory(*gt, traj, eo);
 		res.ateRmse = errs.ate.rmse;
 		return errs;
@@ -329,7 +331,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	res.frames = sys.stats().frames;
 	res.tracked = sys.stats().tracked;
 	res.fps = res.frames / std::max(wall, 1e-9);
-	const auto errs = evaluateAgainstGroundTruth(gt, traj.poses, cfg.sensor, res);
+	const auto errs = evaluateAgainstGroundTruth(gt, traj.poses, sys.metricUnits(), res);
 
 	const SlamReportInput reportInput{
 		o, cfg, res, input.live ? input.live->describe() : o.input, static_cast<bool>(input.live), loaded, wall, memory, errs, outputs.errors()};

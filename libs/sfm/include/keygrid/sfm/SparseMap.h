@@ -103,6 +103,11 @@ class SparseMap
 	 * they matched; this maps them onto the current map. */
 	LandmarkId resolve(LandmarkId id) const;
 
+	/** Scales the map by s > 0 about the world origin (monocular maps, whose unit is
+	 * arbitrary): keyframe camera centres, landmark positions and their scale-invariance
+	 * distances, and the relative poses kept for erased keyframes; orientations unchanged.
+	 * Throws std::invalid_argument unless s is finite and > 0. */
+	void rescale(double s);
 	/** Recomputes normal, distance limits and representative descriptor of a landmark. */
 	void updateLandmarkStats(LandmarkId lm);
 	/** Recomputes the covisibility edges of kf (and the reverse edges). */

@@ -152,6 +152,10 @@ class Tracker
 	 * tracking went on while the loop was closed): the last frame follows its reference
 	 * keyframe. */
 	void onMapCorrected();
+	/** After the map was scaled by s about the world origin (SparseMap::rescale: a monocular
+	 * map given metric scale): the last pose, the motion model and the last frame's pose
+	 * relative to its reference keyframe scale with it. */
+	void onMapRescaled(double s);
 	const TrackerOptions& options() const { return m_opts; }
 	/** Landmarks matched as inliers in the last frame (for diagnostics and the maps). */
 	const std::vector<LandmarkId>& lastInlierLandmarks() const { return m_lastInliers; }

@@ -3,7 +3,8 @@
  * Everything one keygrid-slam run is configured with, loaded from one INI file.
  *
  * Sections: [slam] (mode, sensor, camera), [features], [tracker], [monocular] (map start and
- * keyframes without depth), [mapping] (local mapping and local
+ * keyframes without depth), [camera_height_scale] (monocular: metric scale from the camera's
+ * height), [mapping] (local mapping and local
  * bundle adjustment), [refinement] (final global bundle adjustment and frame re-estimation),
  * [loop_closing] (place recognition and pose graph), [maps] (how keyframes feed the maps), [floor]
  * (the floor frame every map output is written in), [store] (the session file of --map) and [MappingApplication] (the maps themselves, MRPT's
@@ -14,6 +15,7 @@
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/TrackerOptions.h>
 #include <keygrid/slam/MetricMaps.h>
+#include <keygrid/slam/MetricScale.h>
 #include <keygrid/slam/SessionRecorder.h>
 
 #include <string>
@@ -118,6 +120,8 @@ struct SlamConfig
 	maps::FloorFrameOptions floor;
 	loop::LoopClosingOptions loop;
 	SessionRecorderOptions store;
+	/** Monocular: metric scale from camera_height ([camera_height_scale]; 0 = none). */
+	MetricScaleOptions metricScale;
 
 	/** The [slam] keys (mode, sensor, camera, mapping_lag, busy_keyframe_ratio). */
 	core::OptionFields fields();

@@ -163,6 +163,12 @@ class System
 	StageTimings& timings() { return m_timings; }
 	const StageTimings& timings() const { return m_timings; }
 	const SlamConfig& config() const { return m_cfg; }
+	/** The map is in metres: measured depth (RGB-D), or a monocular map given metric scale
+	 * from camera_height; otherwise its unit is arbitrary (a trajectory is compared with a
+	 * Sim(3) alignment). */
+	bool metricUnits() const { return m_cfg.sensor == Sensor::Rgbd || (m_metricScale && m_metricScale->metric()); }
+	/** Monocular with camera_height: the metric scale keeper; nullptr otherwise. */
+	const MetricScale* metricScale() const { return m_metricScale ? &*m_metricScale : nullptr; }
 
    private:
 	/** A new keyframe on its way through local mapping and loop closing. */
@@ -183,6 +189,10 @@ class System
 	void recordLocalMapping(const sfm::LocalMappingReport& rep, double seconds);
 	/** Monocular: a tracker's initialization message into m_initLog, at a bounded rate. */
 	void logInitialization(const sfm::TrackedFrame& tf);
+	/** Monocular with camera_height, after a new keyframe (map lock held): the map rescaled
+	 * when an estimate is due and succeeds, with the tracker, the frames (`tf`, the current
+	 * one, included) and the path length. */
+	void applyMetricScale(sfm::TrackedFrame& tf);
 	/** Monocular map start: the frame that became the first keyframe references it now. */
 	void attachInitialKeyFrame(const sfm::TrackedFrame& tf);
 	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
@@ -248,6 +258,7 @@ class System
 	sfm::LocalMapper m_mapper;
 	std::vector<sfm::TrackedFrame> m_frames;
 	std::vector<std::string> m_initLog;  //!< see initializationLog()
+	std::optional<MetricScale> m_metricScale;  //!< see metricScale()
 	std::size_t m_initLogLastFrame{0};  //!< frame of the last line of m_initLog
 	std::size_t m_initLogSkipped{0};  //!< messages left out since then
 	std::vector<std::optional<mrpt::poses::CPose3D>> m_refined;
