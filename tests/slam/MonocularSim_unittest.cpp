@@ -3,6 +3,7 @@
 // runs the shipped config/sim_monocular.ini on it, and the trajectory is scored against the
 // simulator's exact ground truth after a Sim(3) alignment (a monocular map has no scale).
 #include <keygrid/core/TumTrajectory.h>
+#include <keygrid/eval/TrajectoryErrors.h>
 #include <keygrid/slam/apps/SlamApp.h>
 #include <mrpt/system/filesystem.h>
 
@@ -51,4 +52,51 @@ TEST(MonocularSim, StartsFromTwoViewsAndTracksARenderedSequenceWithinOnePercentO
 			travelled += (gt[i].T_world_cam.translation() - gt[i - 1].T_world_cam.translation()).norm();
 	ASSERT_TRUE(r.ateRmse.has_value());
 	EXPECT_LT(*r.ateRmse, 0.01 * travelled) << "path " << travelled << " m";
+}
+
+// With the camera's height (1.30 m in the test scenes) the monocular map is rescaled to metres
+// from its floor points: room_floor_view's camera looks down at the floor, the trajectory is
+// compared without a scale (SE(3)), and the scale a Sim(3) alignment would still apply is the
+// remaining scale error.
+TEST(MonocularSim, CameraHeightGivesAMetricTrajectory)
+{
+	const std::string dir = test::scratchDir("monocular_sim_height");
+	test::SimSlamRun run;
+	run.rendered = test::runCommand(
+					   test::toolPath("keygrid-sim") + " --quiet --scene " + test::dataDir() +
+						   "/sim/room_floor_view.ini --set 'output.sensor=monocular' --voxel-resolution 0 --floorplan-resolution 0 --output " +
+						   dir + "/seq",
+					   &run.simLog) == 0;
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	auto& o = run.options;
+	o.configPath = test::sourceDir() + "/config/sim_monocular.ini";
+	o.set = "camera_height_scale.camera_height=1.30";
+	o.input = dir + "/seq/sequence.rawlog";
+	o.output = dir + "/out";
+	o.groundTruth = dir + "/seq/groundtruth.txt";
+	o.quiet = true;
+	const auto r = slam::runSlam(o);
+	ASSERT_TRUE(r.error.empty()) << r.error;
+
+	const auto report = nlohmann::json::parse(test::readTextFile(o.output + "/report.json"));
+	ASSERT_EQ(report.at("scale_source"), "camera_height") << report.at("camera_height_scale").dump();
+	EXPECT_EQ(report.at("ate_alignment"), "se3");
+	const auto startFrame = report.at("initialization").at("frame").get<std::size_t>();
+	EXPECT_EQ(r.tracked, r.frames - startFrame);
+
+	const auto est = core::readTumTrajectory(o.output + "/trajectory.txt");
+	const auto gt = core::readTumTrajectory(dir + "/seq/groundtruth.txt");
+	double travelled = 0;
+	for (std::size_t i = 1; i < gt.size(); i++)
+		if (gt[i - 1].t >= est.front().t - 1e-6) travelled += (gt[i].T_world_cam.translation() - gt[i - 1].T_world_cam.translation()).norm();
+	ASSERT_TRUE(r.ateRmse.has_value());
+	// The issue's bound for metric monocular runs: 1.5 % of the path, without a scale.
+	EXPECT_LT(*r.ateRmse, 0.015 * travelled) << "path " << travelled << " m";
+	// The scale left: the floor of this short sequence is seen by a few keyframes, its points
+	// triangulated over short baselines (doc/frontend.md "Monocular mode"): 5 %, not the 2 %
+	// the issue asks of the longer benchmark loops.
+	eval::TrajectoryErrorOptions eo;
+	eo.withScale = true;
+	const auto sim3 = eval::evaluateTrajectory(gt, est, eo);
+	EXPECT_NEAR(sim3.alignment.s, 1.0, 0.05);
 }
