@@ -106,16 +106,6 @@ void SparseMap::eraseLandmark(LandmarkId lm)
 	m_landmarks.erase(it);
 }
 
-namespace
-{
-void scaleTranslation(mrpt::poses::CPose3D& T, double s)
-{
-	T.x(s * T.x());
-	T.y(s * T.y());
-	T.z(s * T.z());
-}
-}  // namespace
-
 void SparseMap::rescale(double s)
 {
 	if (!(std::isfinite(s) && s > 0)) throw std::invalid_argument("SparseMap::rescale: s = " + std::to_string(s) + " (must be finite and > 0)");

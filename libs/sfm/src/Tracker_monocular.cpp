@@ -160,9 +160,7 @@ bool Tracker::startMonocularMap(Current& cur, const TwoViewResult& r, const std:
 	}
 	const double s = 1.0 / median;
 	auto& kf2 = m_map.keyframe(id2);
-	kf2.T_world_cam.x(kf2.T_world_cam.x() * s);
-	kf2.T_world_cam.y(kf2.T_world_cam.y() * s);
-	kf2.T_world_cam.z(kf2.T_world_cam.z() * s);
+	scaleTranslation(kf2.T_world_cam, s);
 	for (LandmarkId l : m_map.keyframe(id1).landmarks)
 		if (l != kNoLandmark && m_map.hasLandmark(l))
 		{
@@ -214,15 +212,9 @@ bool Tracker::startMonocularMap(Current& cur, const TwoViewResult& r, const std:
 
 void Tracker::onMapRescaled(double s)
 {
-	const auto scaled = [s](mrpt::poses::CPose3D T) {
-		T.x(s * T.x());
-		T.y(s * T.y());
-		T.z(s * T.z());
-		return T;
-	};
-	m_lastPose = scaled(m_lastPose);
-	if (m_velocity) m_velocity = scaled(*m_velocity);
-	if (m_lastRelative) m_lastRelative->second = scaled(m_lastRelative->second);
+	scaleTranslation(m_lastPose, s);
+	if (m_velocity) scaleTranslation(*m_velocity, s);
+	if (m_lastRelative) scaleTranslation(m_lastRelative->second, s);
 }
 
 bool Tracker::needKeyFrameMonocular(const Current& cur) const

@@ -246,20 +246,15 @@ void System::applyMetricScale(sfm::TrackedFrame& tf)
 	m_map.noteCorrection();
 	m_correctionsSeen = m_map.corrections();
 	m_tracker.onMapRescaled(*s);
-	const auto scaled = [f = *s](mrpt::poses::CPose3D& T) {
-		T.x(f * T.x());
-		T.y(f * T.y());
-		T.z(f * T.z());
-	};
-	scaled(tf.T_world_cam);
-	scaled(tf.T_ref_cam);
+	sfm::scaleTranslation(tf.T_world_cam, *s);
+	sfm::scaleTranslation(tf.T_ref_cam, *s);
 	for (auto& f : m_frames)
 	{
-		scaled(f.T_world_cam);
-		scaled(f.T_ref_cam);
+		sfm::scaleTranslation(f.T_world_cam, *s);
+		sfm::scaleTranslation(f.T_ref_cam, *s);
 	}
 	m_travelled *= *s;
-	if (m_lastTrackedPose) scaled(*m_lastTrackedPose);
+	if (m_lastTrackedPose) sfm::scaleTranslation(*m_lastTrackedPose, *s);
 }
 
 void System::attachInitialKeyFrame(const sfm::TrackedFrame& tf)

@@ -158,5 +158,12 @@ class SparseMap
 
 /** Eigen position of a CPose3D translation. */
 inline Eigen::Vector3d translationOf(const mrpt::poses::CPose3D& p) { return {p.x(), p.y(), p.z()}; }
+/** The pose's translation multiplied by s, its rotation kept (a map scaled about its origin). */
+inline void scaleTranslation(mrpt::poses::CPose3D& p, double s)
+{
+	p.x(s * p.x());
+	p.y(s * p.y());
+	p.z(s * p.z());
+}
 
 }  // namespace keygrid::sfm
