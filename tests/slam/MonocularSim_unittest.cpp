@@ -100,3 +100,28 @@ TEST(MonocularSim, CameraHeightGivesAMetricTrajectory)
 	const auto sim3 = eval::evaluateTrajectory(gt, est, eo);
 	EXPECT_NEAR(sim3.alignment.s, 1.0, 0.05);
 }
+
+// A real sequence too short to start a monocular map (TUM fr1_desk, 9 frames, its depth
+// ignored): the run succeeds without a pose, report.json says the map never started, and
+// slam.log ends with the initializer's last reason although the rate bound left it out.
+TEST(MonocularSim, ASequenceThatNeverStartsAMapSaysWhy)
+{
+	KEYGRID_SKIP_WITHOUT_SHARED_DATA("tum_fr1_desk_9frames");
+	slam::SlamRunOptions o;
+	o.configPath = test::sourceDir() + "/config/tum_fr1.ini";
+	o.set = "slam.sensor=monocular";
+	o.input = test::sharedDataDir() + "/tum_fr1_desk_9frames";
+	o.output = test::scratchDir("monocular_never") + "/out";
+	o.quiet = true;
+	const auto r = slam::runSlam(o);
+	ASSERT_TRUE(r.error.empty()) << r.error;
+	EXPECT_EQ(r.frames, 9u);
+	EXPECT_EQ(r.tracked, 0u);
+	const auto report = nlohmann::json::parse(test::readTextFile(o.output + "/report.json"));
+	EXPECT_FALSE(report.at("initialization").at("started").get<bool>());
+	EXPECT_EQ(report.at("sensor"), "monocular");
+	const std::string log = test::readTextFile(o.output + "/slam.log");
+	EXPECT_NE(log.find("frame 0: reference frame of the map start"), std::string::npos) << log;
+	EXPECT_NE(log.find("frame 8 with reference frame"), std::string::npos) << log;
+	EXPECT_NE(log.find("messages left out before]"), std::string::npos) << log;
+}

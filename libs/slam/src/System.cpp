@@ -227,6 +227,7 @@ void System::logInitialization(const sfm::TrackedFrame& tf)
 	if (m_initLog.size() >= kMaxLines || !(always || due))
 	{
 		++m_initLogSkipped;
+		m_initLogLastMessage = tf.initMessage;
 		return;
 	}
 	std::string line = tf.initMessage;
@@ -530,6 +531,13 @@ void System::joinThreads()
 void System::finish()
 {
 	joinThreads();
+	// The last initialization message left out by the rate bound: a sequence that never
+	// starts a map ends with why.
+	if (m_initLogSkipped > 0 && !m_initLogLastMessage.empty())
+	{
+		m_initLog.push_back(m_initLogLastMessage + " [" + std::to_string(m_initLogSkipped - 1) + " messages left out before]");
+		m_initLogSkipped = 0;
+	}
 	if (m_finished || !m_K || m_map.numKeyFrames() == 0) return;
 	m_finished = true;
 	// Keyframe poses before the refinement (erased keyframes via their parents).

@@ -139,7 +139,8 @@ class System
 	std::size_t numKeyFrames() const;
 	const std::vector<sfm::TrackedFrame>& frames() const { return m_frames; }
 	/** Monocular: what the frames before the map start did (reference frames, why two-view
-	 * initialization failed, the start), at a bounded rate (slam.log). */
+	 * initialization failed, the start), at a bounded rate (slam.log); after finish() it ends
+	 * with the last message left out, if any. */
 	const std::vector<std::string>& initializationLog() const { return m_initLog; }
 	/** A snapshot of the counters (several threads update them in threaded mode). */
 	SystemStats stats() const;
@@ -261,6 +262,7 @@ class System
 	std::optional<MetricScale> m_metricScale;  //!< see metricScale()
 	std::size_t m_initLogLastFrame{0};  //!< frame of the last line of m_initLog
 	std::size_t m_initLogSkipped{0};  //!< messages left out since then
+	std::string m_initLogLastMessage;  //!< the last of them
 	std::vector<std::optional<mrpt::poses::CPose3D>> m_refined;
 	std::optional<sfm::PinholeIntrinsics> m_K;
 	bool m_finished{false};
