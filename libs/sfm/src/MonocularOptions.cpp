@@ -14,6 +14,7 @@ core::OptionFields MonocularOptions::fields()
 	f.add("init_max_distance_sift", initMaxDistanceSift, "largest SIFT descriptor distance of an initial match [L2]", R::positive());
 	f.add("init_ratio", initRatio, "best / second-best distance ratio of an initial match", R::aboveUpTo(0, 1));
 	f.add("init_check_orientation", initCheckOrientation, "keep initial matches with a consistent orientation change");
+	f.add("init_plane_normal_deg", initPlaneNormalDeg, "ambiguous plane motions: take the one whose plane stays within this angle [deg]; 0 = off", R::inRange(0, 90));
 	f.add("init_min_landmarks", initMinLandmarks, "landmarks the two-view map must keep after its bundle adjustment", R::positive());
 	f.add("init_ba_iterations", initBaIterations, "bundle adjustment iterations of the two first keyframes", R::positive());
 	f.add("keyframe_tracked_ratio", keyFrameTrackedRatio, "new keyframe below this share of the reference's landmarks", R::aboveUpTo(0, 1));

@@ -10,6 +10,7 @@
 #include "detail/TrackerConstants.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 namespace keygrid::sfm
@@ -91,8 +92,26 @@ bool Tracker::initializeMonocular(Current& cur, TrackedFrame& out)
 		m.scale_ref.push_back(ref.features.levelScale[ref.features.keypoints[i].octave]);
 		m.scale_cur.push_back(cur.features.levelScale[cur.features.keypoints[j].octave]);
 	}
-	const TwoViewResult r = TwoViewInitializer(m_K, mo.twoView).initialize(m);
-	if (r.ok && startMonocularMap(cur, r, pairs, out)) return true;
+	TwoViewResult r = TwoViewInitializer(m_K, mo.twoView).initialize(m);
+	const auto resolved = resolvePlaneAmbiguity(r);
+	if (resolved)
+	{
+		const auto j = resolved;
+		// The motion whose plane the first ambiguous frame saw too: its points become the map.
+		const auto& c = r.candidates[*j];
+		r.ok = true;
+		r.motion = c.motion;
+		r.points_ref = c.points_ref;
+		r.triangulated = c.triangulated;
+		r.inliers = c.triangulated;
+		r.numInliers = static_cast<int>(std::count(c.triangulated.begin(), c.triangulated.end(), uint8_t{1}));
+		r.parallaxDeg = c.parallaxDeg;
+	}
+	if (r.ok && startMonocularMap(cur, r, pairs, out))
+	{
+		if (resolved) out.initMessage += "; the plane of the first ambiguous frame picked the motion";
+		return true;
+	}
 	if (!r.ok) out.initMessage = head + std::to_string(n) + " matches, " + r.message;
 	if (static_cast<int>(cur.frame->index - ref.index) >= mo.initMaxFrames)
 	{
@@ -101,6 +120,33 @@ bool Tracker::initializeMonocular(Current& cur, TrackedFrame& out)
 		out.initNewReference = true;
 	}
 	return false;
+}
+
+std::optional<std::size_t> Tracker::resolvePlaneAmbiguity(const TwoViewResult& r)
+{
+	const double tol = m_opts.mono.initPlaneNormalDeg * M_PI / 180.0;
+	if (!(tol > 0) || r.failure != TwoViewFailure::Ambiguous || r.model != TwoViewModel::Homography || r.candidates.size() < 2)
+		return std::nullopt;
+	auto& first = m_monoRef->ambiguousNormals;
+	if (first.empty())
+	{
+		for (const auto& c : r.candidates) first.push_back(c.planeNormal_ref);
+		return std::nullopt;
+	}
+	// Angle of each candidate's plane to the nearest plane of the first ambiguous result.
+	std::vector<double> angle;
+	for (const auto& c : r.candidates)
+	{
+		double best = M_PI;
+		for (const auto& n : first) best = std::min(best, std::acos(std::clamp(c.planeNormal_ref.dot(n), -1.0, 1.0)));
+		angle.push_back(best);
+	}
+	const auto j = static_cast<std::size_t>(std::min_element(angle.begin(), angle.end()) - angle.begin());
+	const auto& tri = r.candidates[j].triangulated;
+	if (!(angle[j] < tol) || std::count(tri.begin(), tri.end(), uint8_t{1}) < m_opts.mono.twoView.minTriangulated) return std::nullopt;
+	for (std::size_t k = 0; k < angle.size(); k++)
+		if (k != j && !(angle[k] > 2 * tol)) return std::nullopt;
+	return j;
 }
 
 bool Tracker::startMonocularMap(Current& cur, const TwoViewResult& r, const std::vector<std::pair<int, int>>& pairs, TrackedFrame& out)

@@ -40,6 +40,15 @@ struct MonocularOptions
 	/** Keep only matches whose keypoint orientation change is among the three most frequent
 	 * (30 bins), ORB-SLAM's rotation consistency check (Default: true) */
 	bool initCheckOrientation{true};
+	/** A plane seen from the reference: the homography's motions stay ambiguous whatever the
+	 * parallax. Each implies a plane; the true one is the same from every current frame, the
+	 * other turns with the direction of travel. A later ambiguous frame takes the motion whose
+	 * plane normal is within this angle of one implied by the first ambiguous frame of the same
+	 * reference, when every other motion's is more than twice as far [deg]; 0 = off. Off by
+	 * default: the first ambiguous frame's normals rest on little parallax, and on a camera
+	 * looking down at the floor the rule picked a wrong motion (doc/frontend.md)
+	 * (Default: 0) */
+	double initPlaneNormalDeg{0.0};
 	/** Landmarks the two-view map must keep after its bundle adjustment, else the map start
 	 * is undone and retried (Default: 100, as ORB-SLAM) */
 	int initMinLandmarks{100};

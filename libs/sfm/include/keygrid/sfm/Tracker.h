@@ -265,7 +265,13 @@ class Tracker
 		cv::Mat colour;
 		FrameFeatures features;
 		std::vector<cv::Point2f> predicted;
+		/** Plane normals of the motions of the first ambiguous two-view result with this
+		 * reference (see MonocularOptions::initPlaneNormalDeg) */
+		std::vector<Eigen::Vector3d> ambiguousNormals;
 	};
+	/** An ambiguous homography result with this reference resolved by the plane the first
+	 * ambiguous result implied: the index of the candidate to take, or nullopt. */
+	std::optional<std::size_t> resolvePlaneAmbiguity(const TwoViewResult& r);
 	std::optional<MonocularReference> m_monoRef;
 };
 
