@@ -107,3 +107,40 @@ TEST(SparseMap, ResolvedLandmarksTableAgreesWithResolve)
 	EXPECT_EQ(table[ids[6]], nullptr);
 	EXPECT_EQ(table[ids[7]], &m.landmark(ids[7]));
 }
+
+TEST(SparseMap, RescaleScalesCentresPointsDistancesAndErasedRelativePoses)
+{
+	SparseMap m;
+	const auto a = m.addKeyFrame(makeKf(CPose3D(0.5, -0.2, 1.0, 0.3, 0.1, -0.2), 10)).id;
+	const auto b = m.addKeyFrame(makeKf(CPose3D(1.5, 0.4, 0.8, 0.5, 0, 0.1), 10)).id;
+	auto kfC = makeKf(CPose3D(2.0, 0.1, 0.9, 0.6, 0.05, 0.1), 10);
+	kfC.parent = b;
+	kfC.hasParent = true;
+	const auto c = m.addKeyFrame(kfC).id;
+	const auto l = m.addLandmark({1, 2, 3}, a, 0);
+	m.addObservation(l, b, 0);
+	m.updateLandmarkStats(l);
+	const auto before = m.landmark(l);
+	m.eraseKeyFrame(c);
+	const double s = 2.5;
+	m.rescale(s);
+	// x -> s x about the origin: centres and points times s, orientations unchanged.
+	const CPose3D pa = m.keyframe(a).T_world_cam;
+	EXPECT_NEAR(pa.x(), s * 0.5, 1e-12);
+	EXPECT_NEAR(pa.y(), s * -0.2, 1e-12);
+	EXPECT_NEAR(pa.z(), s * 1.0, 1e-12);
+	EXPECT_NEAR(pa.yaw(), 0.3, 1e-12);
+	EXPECT_NEAR((m.landmark(l).p_world - s * Eigen::Vector3d(1, 2, 3)).norm(), 0, 1e-12);
+	EXPECT_NEAR(m.landmark(l).minDistance, s * before.minDistance, 1e-12);
+	EXPECT_NEAR(m.landmark(l).maxDistance, s * before.maxDistance, 1e-12);
+	// The erased keyframe follows its parent at the new scale: its centre is s times the old.
+	CPose3D pc;
+	ASSERT_TRUE(m.poseOf(c, pc));
+	EXPECT_NEAR(pc.x(), s * 2.0, 1e-9);
+	EXPECT_NEAR(pc.y(), s * 0.1, 1e-9);
+	EXPECT_NEAR(pc.z(), s * 0.9, 1e-9);
+	EXPECT_NEAR(pc.yaw(), 0.6, 1e-9);
+	EXPECT_THROW(m.rescale(0), std::invalid_argument);
+	EXPECT_THROW(m.rescale(-1), std::invalid_argument);
+	EXPECT_THROW(m.rescale(std::nan("")), std::invalid_argument);
+}

@@ -431,3 +431,33 @@ TEST(TwoViewInitializer, OptionsAreValidatedAndRead)
 	c.write("init", "min_matches", 3);
 	EXPECT_THROW(r.loadFromConfigFile(c, "init"), std::invalid_argument);
 }
+
+// The two-fold ambiguity of a plane (short baseline, |t| / d = 0.05): refused as Ambiguous,
+// with the competing motions as candidates; one of them is the true motion and implies the
+// true plane, whose normal (noise-free) is kPlaneN turned towards the camera.
+TEST(TwoViewInitializer, AnAmbiguousPlaneListsTheTrueMotionAmongItsCandidates)
+{
+	// Noise-free correspondences: the true motion and plane come out exactly.
+	Scene exact = makeScene(kR, Eigen::Vector3d(0.2, 0.02, 0.02), true, kPoints, 0.0, 4);
+	for (std::size_t i = 0; i < exact.X_ref.size(); i++)
+	{
+		exact.matches.px_ref[i] = project(exact.X_ref[i]);
+		exact.matches.px_cur[i] = project(kR * exact.X_ref[i] + Eigen::Vector3d(0.2, 0.02, 0.02));
+	}
+	const TwoViewResult r = TwoViewInitializer(kK).initialize(exact.matches);
+	ASSERT_EQ(r.failure, TwoViewFailure::Ambiguous) << r.message;
+	ASSERT_GE(r.candidates.size(), 2u);
+	bool foundTruth = false;
+	for (const auto& c : r.candidates)
+	{
+		const double rotErr = Eigen::AngleAxisd(c.motion.R_cur_ref * kR.transpose()).angle() * 180 / M_PI;
+		const double dirErr = angleBetweenDeg(c.motion.t_cur_ref, Eigen::Vector3d(0.2, 0.02, 0.02));
+		if (rotErr < 1e-3 && dirErr < 1e-3)
+		{
+			foundTruth = true;
+			EXPECT_LT(angleBetweenDeg(c.planeNormal_ref, -kPlaneN), 1e-3);
+		}
+		EXPECT_NEAR(c.planeNormal_ref.norm(), 1.0, 1e-12);
+	}
+	EXPECT_TRUE(foundTruth);
+}

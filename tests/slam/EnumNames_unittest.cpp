@@ -76,3 +76,55 @@ TEST(EnumNames, RunModeIsReadAndWrittenAsSequentialOrThreaded)
 	}
 	EXPECT_THROW(slam::runModeFromString("threaded ", "mode"), std::invalid_argument);
 }
+
+TEST(EnumNames, SensorsAreTheWordsOfTheSlamSection)
+{
+	using slam::Sensor;
+	EXPECT_STREQ(slam::toString(Sensor::Rgbd), "rgbd");
+	EXPECT_STREQ(slam::toString(Sensor::Monocular), "monocular");
+	EXPECT_EQ(slam::SlamConfig().sensor, Sensor::Rgbd);
+	EXPECT_FALSE(slam::SlamConfig().tracker.monocular);
+
+	// Monocular: the tracker's mode follows, and the two-view map is adjusted with [mapping]'s
+	// bundle adjustment options.
+	mrpt::config::CConfigFileMemory mono("[slam]\nsensor = monocular\n[mapping]\nfunction_tolerance = 1e-5\n[monocular]\ninit_max_frames = 7\n");
+	slam::SlamConfig cfg;
+	cfg.loadFromConfigFile(mono);
+	EXPECT_EQ(cfg.sensor, Sensor::Monocular);
+	EXPECT_TRUE(cfg.tracker.monocular);
+	EXPECT_EQ(cfg.tracker.mono.initMaxFrames, 7);
+	EXPECT_EQ(cfg.tracker.mono.ba.functionTolerance, 1e-5);
+	mrpt::config::CConfigFileMemory written;
+	cfg.saveToConfigFile(written);
+	const mrpt::config::CConfigFileMemory reread(written.getContent());
+	EXPECT_EQ(reread.read_string("slam", "sensor", ""), "monocular") << written.getContent();
+	EXPECT_EQ(reread.read_int("monocular", "init_max_frames", 0), 7) << written.getContent();
+
+	// Exact words only; the error names the key and the value.
+	for (const char* bad : {"Monocular", "stereo"})
+	{
+		mrpt::config::CConfigFileMemory ini(std::string("[slam]\nsensor = ") + bad + "\n");
+		slam::SlamConfig c;
+		try
+		{
+			c.loadFromConfigFile(ini);
+			ADD_FAILURE() << "accepted sensor '" << bad << "'";
+		}
+		catch (const std::invalid_argument& e)
+		{
+			EXPECT_NE(std::string(e.what()).find(std::string("[slam] sensor = '") + bad + "'"), std::string::npos) << e.what();
+		}
+	}
+	// An invalid [monocular] value names its key.
+	mrpt::config::CConfigFileMemory badRatio("[monocular]\nkeyframe_tracked_ratio = 1.5\n");
+	slam::SlamConfig c;
+	try
+	{
+		c.loadFromConfigFile(badRatio);
+		ADD_FAILURE() << "accepted keyframe_tracked_ratio = 1.5";
+	}
+	catch (const std::invalid_argument& e)
+	{
+		EXPECT_NE(std::string(e.what()).find("[monocular] keyframe_tracked_ratio"), std::string::npos) << e.what();
+	}
+}

@@ -1,7 +1,7 @@
 #pragma once
 /** \file SimSlamRun.h
  * The integration tests' common step: keygrid-sim renders a scene into DIR/seq, and
- * keygrid-slam runs the shipped config/sim.ini on its rawlog into DIR/out. */
+ * keygrid-slam runs a shipped INI (config/sim.ini unless told) on its rawlog into DIR/out. */
 #include <keygrid/slam/apps/SlamApp.h>
 
 #include "TestData.h"
@@ -19,14 +19,16 @@ struct SimSlamRun
 };
 
 /** `simArgs` are keygrid-sim's arguments besides --quiet and --output (e.g. "--scene X.ini
- * --frames 40"); `withGroundTruth` passes DIR/seq/groundtruth.txt as --gt. */
-inline SimSlamRun renderAndRunSlam(const std::string& dir, const std::string& simArgs, bool withGroundTruth)
+ * --frames 40"); `withGroundTruth` passes DIR/seq/groundtruth.txt as --gt; `config` is the
+ * shipped INI to run, relative to the source folder. */
+inline SimSlamRun renderAndRunSlam(
+	const std::string& dir, const std::string& simArgs, bool withGroundTruth, const std::string& config = "config/sim.ini")
 {
 	SimSlamRun run;
 	run.rendered =
 		runCommand(toolPath("keygrid-sim") + " --quiet " + simArgs + " --output " + dir + "/seq", &run.simLog) == 0;
 	if (!run.rendered) return run;
-	run.options.configPath = sourceDir() + "/config/sim.ini";
+	run.options.configPath = sourceDir() + "/" + config;
 	run.options.input = dir + "/seq/sequence.rawlog";
 	run.options.output = dir + "/out";
 	if (withGroundTruth) run.options.groundTruth = dir + "/seq/groundtruth.txt";

@@ -1,7 +1,9 @@
 #include <keygrid/sfm/SparseMap.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace keygrid::sfm
 {
@@ -102,6 +104,19 @@ void SparseMap::eraseLandmark(LandmarkId lm)
 		if (auto k = m_keyframes.find(kf); k != m_keyframes.end() && k->second.landmarks[kp] == lm)
 			k->second.landmarks[kp] = kNoLandmark;
 	m_landmarks.erase(it);
+}
+
+void SparseMap::rescale(double s)
+{
+	if (!(std::isfinite(s) && s > 0)) throw std::invalid_argument("SparseMap::rescale: s = " + std::to_string(s) + " (must be finite and > 0)");
+	for (auto& [id, kf] : m_keyframes) scaleTranslation(kf.T_world_cam, s);
+	for (auto& [id, lm] : m_landmarks)
+	{
+		lm.p_world *= s;
+		lm.minDistance *= s;
+		lm.maxDistance *= s;
+	}
+	for (auto& [id, e] : m_erased) scaleTranslation(e.second, s);
 }
 
 void SparseMap::eraseKeyFrame(KeyFrameId id)

@@ -1,5 +1,7 @@
 #include <keygrid/sfm/Tracker.h>
 
+#include "detail/TrackerConstants.h"
+
 #include <algorithm>
 #include <ctime>
 #include <numeric>
@@ -31,9 +33,6 @@ constexpr int kLocalMapNeighbours = 5;
 /** keyframe_tracked_ratio while the map has a single keyframe (ORB-SLAM2's 0.4): the second
  * keyframe waits for a wider baseline to the first than later keyframes do. */
 constexpr double kTrackedRatioWithOneKeyFrame = 0.4;
-/** A keyframe needs more inliers than this (ORB-SLAM2's 15): a barely tracked frame would
- * bring a poor pose into the map. */
-constexpr int kMinKeyFrameInliers = 15;
 
 /** Inliers a pose needs before the local-map search (motion model, or PnP on the reference
  * keyframe): half of min_inliers, the search adds the matches that reach min_inliers. */
@@ -107,7 +106,7 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 
 	if (m_state == TrackingState::NotInitialized)
 	{
-		if (!initialize(cur, out))
+		if (!(m_opts.monocular ? initializeMonocular(cur, out) : initialize(cur, out)))
 		{
 			out.method = TrackingMethod::Lost;
 			out.T_world_cam = m_lastPose;
@@ -298,6 +297,7 @@ void Tracker::startNewMap()
 	m_state = TrackingState::NotInitialized;
 	m_velocity.reset();
 	m_lastRelative.reset();
+	m_monoRef.reset();
 }
 
 bool Tracker::initialize(Current& cur, TrackedFrame& out)
@@ -559,6 +559,7 @@ void Tracker::updateHoc(Current& cur, TrackedFrame& out)
 
 bool Tracker::needKeyFrame(const Current& cur) const
 {
+	if (m_opts.monocular) return needKeyFrameMonocular(cur);
 	const int sinceLast = static_cast<int>(cur.frame->index - m_lastKfFrame);
 	// Landmarks of the reference keyframe also seen by other keyframes (ORB-SLAM2's "3
 	// observations", where an RGB-D observation counts twice, is 2 keyframes); all of them
@@ -578,7 +579,7 @@ bool Tracker::needKeyFrame(const Current& cur) const
 	const bool weak = cur.inliers < ratio * refMatches || needClose;
 	// Local mapping still busy with the last keyframe: wait for it unless tracking is weak.
 	if (!timeout && m_mappingBusy && !(cur.inliers < m_deferWeakRatio * refMatches) && m_mappingBusy()) return false;
-	return (timeout || weak) && cur.inliers > kMinKeyFrameInliers;
+	return (timeout || weak) && cur.inliers > detail::kMinKeyFrameInliers;
 }
 
 KeyFrame Tracker::keyFrameOf(const Current& cur)
@@ -605,7 +606,8 @@ KeyFrameId Tracker::createKeyFrame(const Current& cur)
 		if (cur.matches[i] != kNoLandmark && m_map.hasLandmark(cur.matches[i]))
 			m_map.addObservation(cur.matches[i], id, static_cast<int>(i));
 	// New landmarks from depth: every close untracked keypoint, then farther ones until the
-	// minimum count is reached (nearest first).
+	// minimum count is reached (nearest first). None without depth (monocular): the
+	// LocalMapper triangulates them.
 	std::vector<std::pair<float, int>> byDepth;
 	for (std::size_t i = 0; i < k.features.size(); i++)
 		if (k.landmarks[i] == kNoLandmark && k.features.depth[i] > 0) byDepth.emplace_back(k.features.depth[i], static_cast<int>(i));

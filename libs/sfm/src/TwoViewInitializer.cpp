@@ -142,6 +142,29 @@ std::vector<RelativeMotion> hypotheses(const TwoViewResult& r, const PinholeIntr
 	return hs;
 }
 
+/** Unit normal of the least-squares plane through the flagged points (the eigenvector of the
+ * smallest eigenvalue of their scatter), turned towards the origin (the reference camera);
+ * zero for fewer than 3 points. */
+Eigen::Vector3d planeNormal(const std::vector<Eigen::Vector3d>& points, const std::vector<uint8_t>& use)
+{
+	Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+	int n = 0;
+	for (std::size_t i = 0; i < points.size(); i++)
+		if (use[i])
+		{
+			mean += points[i];
+			++n;
+		}
+	if (n < 3) return Eigen::Vector3d::Zero();
+	mean /= n;
+	Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+	for (std::size_t i = 0; i < points.size(); i++)
+		if (use[i]) scatter += (points[i] - mean) * (points[i] - mean).transpose();
+	Eigen::Vector3d normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+	if (normal.dot(mean) > 0) normal = -normal;
+	return normal;
+}
+
 /* The best hypothesis (most good points, refined) is accepted when, in this order of diagnosis:
  * it triangulates at least min_triangulated points, its median parallax reaches
  * min_parallax_deg (else: pure rotation or a too short baseline; checked before ambiguity
@@ -188,7 +211,25 @@ TwoViewResult chooseMotion(TwoViewResult r, const detail::WeightedMatches& w, co
 	const int minGood = std::max(o.minTriangulated, static_cast<int>(std::ceil(o.minGoodShare * r.numInliers)));
 	if (b.good < o.minTriangulated) return fail(std::move(r), TwoViewFailure::TooFewTriangulated, m.str());
 	if (b.medianParallaxDeg < o.minParallaxDeg) return fail(std::move(r), TwoViewFailure::LowParallax, m.str());
-	if (r.secondGood > o.maxSecondBestShare * checks[best].good) return fail(std::move(r), TwoViewFailure::Ambiguous, m.str());
+	if (r.secondGood > o.maxSecondBestShare * checks[best].good)
+	{
+		for (std::size_t k = 0; k < hs.size(); k++)
+		{
+			if (k != best && !(checks[k].good > o.maxSecondBestShare * checks[best].good)) continue;
+			const auto& c = k == best ? b : checks[k];
+			TwoViewCandidate cand;
+			cand.motion = k == best ? r.motion : hs[k];
+			cand.points_ref = c.points_ref;
+			cand.triangulated = c.valid;
+			cand.good = c.good;
+			cand.parallaxDeg = c.medianParallaxDeg;
+			cand.planeNormal_ref = planeNormal(c.points_ref, c.valid);
+			if (k == best) r.candidates.insert(r.candidates.begin(), std::move(cand));
+			else
+				r.candidates.push_back(std::move(cand));
+		}
+		return fail(std::move(r), TwoViewFailure::Ambiguous, m.str());
+	}
 	if (b.good < minGood || b.numValid < o.minTriangulated) return fail(std::move(r), TwoViewFailure::TooFewTriangulated, m.str());
 	r.points_ref = b.points_ref;
 	r.triangulated = b.valid;

@@ -11,6 +11,8 @@ namespace keygrid::slam
 {
 const char* toString(RunMode m) { return m == RunMode::Threaded ? "threaded" : "sequential"; }
 
+const char* toString(Sensor s) { return s == Sensor::Monocular ? "monocular" : "rgbd"; }
+
 RunMode runModeFromString(const std::string& text, const std::string& what)
 {
 	if (text == "sequential") return RunMode::Sequential;
@@ -56,6 +58,14 @@ core::OptionFields SlamConfig::fields()
 		 [this] { return std::string(toString(mode)); }},
 		"sequential | threaded", R::oneOf({"sequential", "threaded"}));
 	f.addCustom(
+		"sensor",
+		{[this](const std::string& text) {
+			 if (text != toString(Sensor::Rgbd) && text != toString(Sensor::Monocular)) throw std::invalid_argument("expected rgbd or monocular");
+			 sensor = text == toString(Sensor::Monocular) ? Sensor::Monocular : Sensor::Rgbd;
+		 },
+		 [this] { return std::string(toString(sensor)); }},
+		"rgbd | monocular (images only: two-view map start, arbitrary scale)", R::oneOf({"rgbd", "monocular"}));
+	f.addCustom(
 		"camera", {[this](const std::string& text) { camera = text; }, [this] { return camera.empty() ? std::string("auto") : camera; }},
 		"preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
 	f.add("mapping_lag", mappingLag, "threaded: keyframes local mapping may lag behind tracking (0: none)", R::inRange(0, 5));
@@ -70,15 +80,20 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	features.loadFromConfigFile(c, "features");
 	tracker.loadFromConfigFile(c, "tracker");
 	tracker.hoc.loadFromConfigFile(c, "hoc");
+	tracker.mono.loadFromConfigFile(c, "monocular");
 	mapping.loadFromConfigFile(c, "mapping");
 	refinement.loadFromConfigFile(c, "refinement");
 	maps.loadFromConfigFile(c, "maps");
 	floor.loadFromConfigFile(c, "floor");
 	loop.loadFromConfigFile(c, "loop_closing");
 	store.loadFromConfigFile(c, "store");
+	metricScale.loadFromConfigFile(c, "camera_height_scale");
 	// The depth residual model is shared by tracking and bundle adjustment.
 	mapping.ba.bf = tracker.pose.bf;
 	mapping.ba.disparitySigma = tracker.pose.disparitySigma;
+	tracker.monocular = sensor == Sensor::Monocular;
+	// The two-view map is bundle-adjusted as local mapping adjusts its windows.
+	tracker.mono.ba = mapping.ba;
 }
 
 void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
@@ -87,12 +102,14 @@ void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 	features.saveToConfigFile(c, "features");
 	tracker.saveToConfigFile(c, "tracker");
 	tracker.hoc.saveToConfigFile(c, "hoc");
+	tracker.mono.saveToConfigFile(c, "monocular");
 	mapping.saveToConfigFile(c, "mapping");
 	refinement.saveToConfigFile(c, "refinement");
 	maps.saveToConfigFile(c, "maps");
 	floor.saveToConfigFile(c, "floor");
 	loop.saveToConfigFile(c, "loop_closing");
 	store.saveToConfigFile(c, "store");
+	metricScale.saveToConfigFile(c, "camera_height_scale");
 }
 
 namespace

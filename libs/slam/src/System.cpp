@@ -27,6 +27,7 @@ System::System(const SlamConfig& cfg)
 	  m_mapper(m_map, cfg.mapping, cfg.tracker.matcher),
 	  m_images(std::make_unique<KeyFrameImageCache>(static_cast<std::size_t>(cfg.store.imageCacheMib) << 20))
 {
+	if (cfg.sensor == Sensor::Monocular && cfg.metricScale.enabled()) m_metricScale.emplace(cfg.metricScale);
 	if (cfg.loop.enabled)
 	{
 		m_loopCloser = std::make_unique<loop::LoopCloser>(m_map, m_mapper, cfg.loop, cfg.tracker.matcher, cfg.features.type);
@@ -142,6 +143,16 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	sfm::TrackedFrame tf = m_tracker.track(frame, std::move(features));
 	m_timings.add("track", secondsSince(t0));
 	if (m_cfg.tracker.hoc.enabled) m_timings.add("hoc", tf.hocSeconds);
+	if (!tf.initMessage.empty()) logInitialization(tf);
+	// Monocular map start: the first keyframe (the reference frame, at the origin) is mapped
+	// before the second, and the path starts there.
+	std::optional<KeyFrameJob> initialJob;
+	if (tf.hasInitialKeyFrame)
+	{
+		initialJob = KeyFrameJob{tf.initialKeyFrame, tf.initialFrameIndex, m_travelled, K};
+		m_lastTrackedPose = m_map.keyframe(tf.initialKeyFrame).T_world_cam;
+		attachInitialKeyFrame(tf);
+	}
 	// A loop closed on another thread moved the map: the path length restarts from here.
 	if (m_map.corrections() != m_correctionsSeen)
 	{
@@ -156,10 +167,16 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	const KeyFrameJob job{tf.keyframe, tf.index, m_travelled, K};
 	if (tf.newKeyFrame && !m_mappingQueue)
 	{
+		if (initialJob)
+		{
+			mapKeyFrame(*initialJob);
+			insertAndCloseLoops(*initialJob, nullptr);
+		}
 		mapKeyFrame(job);
 		insertAndCloseLoops(job, &tf);
 	}
 	if (m_extending && !m_startedInStoredMap && !m_startedNewMap) startExtending(tf);
+	if (m_metricScale && tf.newKeyFrame) applyMetricScale(tf);
 	tf.mapLandmarks = m_map.numLandmarks();
 	lock.unlock();
 	{
@@ -178,9 +195,19 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 			m_stats.lost++;
 		if (tf.method == sfm::TrackingMethod::Relocalization && tf.tracked) m_stats.relocalizations++;
 		if (tf.method == sfm::TrackingMethod::Pnp && tf.tracked) m_stats.pnpFallbacks++;
+		if (tf.hasInitialKeyFrame)
+		{
+			m_stats.framesToInitialize = m_stats.frames;
+			m_stats.initializationFrame = tf.index;
+		}
 	}
 	const bool queueKeyFrame = tf.newKeyFrame && m_mappingQueue;
 	m_frames.push_back(std::move(tf));
+	if (queueKeyFrame && initialJob)
+	{
+		if (!m_mappingQueue->push(*initialJob)) throwIfBackgroundFailed();
+		m_jobsQueued++;
+	}
 	if (queueKeyFrame)
 	{
 		if (!m_mappingQueue->push(job)) throwIfBackgroundFailed();
@@ -188,6 +215,60 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		waitForMapping();
 	}
 	return m_frames.back();
+}
+
+void System::logInitialization(const sfm::TrackedFrame& tf)
+{
+	// Every change of reference and the start are logged; repeated failures with one
+	// reference once per kEvery frames, and no more than kMaxLines lines in all.
+	constexpr std::size_t kEvery = 10, kMaxLines = 500;
+	const bool always = tf.hasInitialKeyFrame || tf.initNewReference;
+	const bool due = m_initLog.empty() || tf.index >= m_initLogLastFrame + kEvery;
+	if (m_initLog.size() >= kMaxLines || !(always || due))
+	{
+		++m_initLogSkipped;
+		m_initLogLastMessage = tf.initMessage;
+		return;
+	}
+	std::string line = tf.initMessage;
+	if (m_initLogSkipped) line += " [" + std::to_string(m_initLogSkipped) + " messages left out before]";
+	m_initLog.push_back(std::move(line));
+	m_initLogLastFrame = tf.index;
+	m_initLogSkipped = 0;
+}
+
+void System::applyMetricScale(sfm::TrackedFrame& tf)
+{
+	const auto t0 = std::chrono::steady_clock::now();
+	const auto s = m_metricScale->update(m_map);
+	m_timings.add("metric_scale", secondsSince(t0));
+	if (!s) return;
+	// A bundle adjustment solved meanwhile (threaded mode) was solved at the old scale.
+	m_map.noteCorrection();
+	m_correctionsSeen = m_map.corrections();
+	m_tracker.onMapRescaled(*s);
+	sfm::scaleTranslation(tf.T_world_cam, *s);
+	sfm::scaleTranslation(tf.T_ref_cam, *s);
+	for (auto& f : m_frames)
+	{
+		sfm::scaleTranslation(f.T_world_cam, *s);
+		sfm::scaleTranslation(f.T_ref_cam, *s);
+	}
+	m_travelled *= *s;
+	if (m_lastTrackedPose) sfm::scaleTranslation(*m_lastTrackedPose, *s);
+}
+
+void System::attachInitialKeyFrame(const sfm::TrackedFrame& tf)
+{
+	for (auto it = m_frames.rbegin(); it != m_frames.rend(); ++it)
+	{
+		if (it->index != tf.initialFrameIndex) continue;
+		it->hasReference = true;
+		it->reference = tf.initialKeyFrame;
+		it->T_ref_cam = mrpt::poses::CPose3D();
+		it->T_world_cam = m_map.keyframe(tf.initialKeyFrame).T_world_cam;
+		return;
+	}
 }
 
 void System::mapKeyFrame(const KeyFrameJob& job)
@@ -450,6 +531,13 @@ void System::joinThreads()
 void System::finish()
 {
 	joinThreads();
+	// The last initialization message left out by the rate bound: a sequence that never
+	// starts a map ends with why.
+	if (m_initLogSkipped > 0 && !m_initLogLastMessage.empty())
+	{
+		m_initLog.push_back(m_initLogLastMessage + " [" + std::to_string(m_initLogSkipped - 1) + " messages left out before]");
+		m_initLogSkipped = 0;
+	}
 	if (m_finished || !m_K || m_map.numKeyFrames() == 0) return;
 	m_finished = true;
 	// Keyframe poses before the refinement (erased keyframes via their parents).

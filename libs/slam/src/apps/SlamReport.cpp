@@ -103,6 +103,21 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	js["config"] = in.options.configPath;
 	js["config_set"] = in.options.set.empty() ? Json() : Json(in.options.set);
 	js["mode"] = toString(cfg.mode);
+	js["sensor"] = toString(cfg.sensor);
+	// What gives the map its scale: measured depth, or nothing (monocular: arbitrary units).
+	const MetricScale* ms = sys.metricScale();
+	js["scale_source"] = cfg.sensor == Sensor::Rgbd ? "depth" : ms && ms->metric() ? "camera_height" : "none";
+	if (ms)
+		js["camera_height_scale"] = {{"camera_height_m", cfg.metricScale.estimator.cameraHeight},
+									 {"estimates", ms->stats().estimates},
+									 {"applied", ms->stats().applied},
+									 {"total_factor", ms->stats().totalFactor},
+									 {"last_factor", ms->stats().lastFactor},
+									 {"last_message", ms->stats().lastMessage}};
+	if (cfg.sensor == Sensor::Monocular)
+		js["initialization"] = {{"started", st.framesToInitialize > 0},
+								{"frames", st.framesToInitialize > 0 ? Json(st.framesToInitialize) : Json()},
+								{"frame", st.framesToInitialize > 0 ? Json(st.initializationFrame) : Json()}};
 	js["frames"] = st.frames;
 	js["tracked"] = st.tracked;
 	js["lost"] = st.lost;
@@ -151,6 +166,11 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	js["track_and_map_ms_per_100_frames"] = blocks;
 	if (in.errors)
 	{
+		// A map without metric scale (monocular): after a Sim(3) alignment, whose scale (metres
+		// per map unit) is recorded.
+		const bool sim3 = !sys.metricUnits();
+		js["ate_alignment"] = sim3 ? "sim3" : "se3";
+		if (sim3) js["ate_sim3_scale"] = in.errors->alignment.s;
 		js["ate_rmse_m"] = in.errors->ate.rmse;
 		js["ate_rot_rmse_deg"] = in.errors->ateRotDeg.rmse;
 		if (in.errors->rpeTrans)

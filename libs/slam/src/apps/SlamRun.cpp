@@ -93,7 +93,11 @@ RunInput openRunInput(const SlamRunOptions& o, const mrpt::config::CConfigFileMe
 {
 	core::FrameSourceOptions so;
 	if (!cfg.camera.empty() && cfg.camera != "auto") so.camera = core::RgbdCamera::FromPresetOrFile(cfg.camera);
+	// Monocular: the images alone, whatever else the input holds.
+	if (cfg.sensor == Sensor::Monocular) so.depth = core::DepthUse::Ignore;
 	RunInput in;
+	if (o.live && cfg.sensor == Sensor::Monocular)
+		throw std::invalid_argument("[slam] sensor = monocular: the live camera (OpenNI2) is RGB-D only; record a plain camera with rawlog-grabber (config/rawlog-grabber/usb_camera.ini) and run on the rawlog");
 	if (o.live)
 		in.live = openLiveCamera(ini, o.configPath, cfg);
 	else
@@ -184,7 +188,7 @@ void noteSkippedInput(const System& sys, const RunInput& in, const TimestampSkip
 	res.skipped = skipped;
 	res.lastSkip = lastSkip;
 	if (res.error.empty() && sys.stats().frames == 0 && !interruptRequested())
-		res.error = "no RGB-D frame in the input" + (skipped ? " (" + std::to_string(skipped) + " entries skipped, the last: " + lastSkip + ")" : std::string());
+		res.error = std::string(sys.config().sensor == Sensor::Monocular ? "no image frame" : "no RGB-D frame") + " in the input" + (skipped ? " (" + std::to_string(skipped) + " entries skipped, the last: " + lastSkip + ")" : std::string());
 	if (skipped)
 		std::cerr << "keygrid-slam: warning: skipped " << skipped << " input entries"
 				  << (lastSkip.empty() ? std::string() : " (last: " + lastSkip + ")") << "\n";
@@ -212,7 +216,7 @@ struct FinalTrajectory
 
 /** Every frame's final pose; with a loaded map only the frames that have a pose in it:
  * localization lists the localized frames (counted in res.localized), extend mode the frames
- * from the first tracked one on. */
+ * from the first tracked one on; monocular mode the frames from the map's first keyframe on. */
 FinalTrajectory finalTrajectory(const System& sys, bool mapLoaded, const SlamRunOptions& o, SlamRunResult& res)
 {
 	FinalTrajectory t{sys.trajectory(), "keygrid-slam trajectory, every frame"};
@@ -238,6 +242,19 @@ FinalTrajectory finalTrajectory(const System& sys, bool mapLoaded, const SlamRun
 			std::cerr << "keygrid-slam: warning: the new map never met the stored one; its " << ex.waitingForMerge
 					  << " keyframes are in a frame of their own, not in the metric maps nor in " << o.loadMap << "\n";
 	}
+	else if (sys.config().sensor == Sensor::Monocular)
+	{
+		// The frames before the map started have no pose (two-view initialization), except
+		// the reference frame that became its first keyframe.
+		const auto& frames = sys.frames();
+		std::size_t start = 0;
+		while (start < frames.size() && frames[start].method != sfm::TrackingMethod::Init) start++;
+		core::Trajectory kept;
+		for (std::size_t i = 0; i < t.poses.size() && i < frames.size(); i++)
+			if (i >= start || frames[i].hasReference) kept.push_back(t.poses[i]);
+		t.poses = std::move(kept);
+		t.title = "keygrid-slam trajectory, every frame from the map start on (monocular: arbitrary scale)";
+	}
 	return t;
 }
 
@@ -252,15 +269,20 @@ void writeOutputFiles(System& sys, const SlamConfig& cfg, const FinalTrajectory&
 	if (res.error.empty() && !outputs.errors().empty()) res.error = outputs.errors().front();
 }
 
-/** ATE and RPE of the final trajectory against --gt (at least three poses); a failed
- * evaluation becomes the run's error when it has none. */
+/** ATE and RPE of the final trajectory against --gt (at least three poses), after a Sim(3)
+ * alignment for a map without metric units; a failed evaluation becomes the run's error when it
+ * has none. */
 std::optional<eval::TrajectoryErrors> evaluateAgainstGroundTruth(
-	const std::optional<core::Trajectory>& gt, const core::Trajectory& traj, SlamRunResult& res)
+	const std::optional<core::Trajectory>& gt, const core::Trajectory& traj, bool metricUnits, SlamRunResult& res)
 {
 	if (!gt || traj.size() < 3) return std::nullopt;
 	try
 	{
-		auto errs = eval::evaluateTrajectory(*gt, traj);
+		// A monocular trajectory without metric scale has the map's arbitrary unit: aligned
+		// with a Sim(3).
+		eval::TrajectoryErrorOptions eo;
+		eo.withScale = !metricUnits;
+		auto errs = eval::evaluateTrajectory(*gt, traj, eo);
 		res.ateRmse = errs.ate.rmse;
 		return errs;
 	}
@@ -309,7 +331,7 @@ SlamRunResult runSlam(const SlamRunOptions& o)
 	res.frames = sys.stats().frames;
 	res.tracked = sys.stats().tracked;
 	res.fps = res.frames / std::max(wall, 1e-9);
-	const auto errs = evaluateAgainstGroundTruth(gt, traj.poses, res);
+	const auto errs = evaluateAgainstGroundTruth(gt, traj.poses, sys.metricUnits(), res);
 
 	const SlamReportInput reportInput{
 		o, cfg, res, input.live ? input.live->describe() : o.input, static_cast<bool>(input.live), loaded, wall, memory, errs, outputs.errors()};

@@ -108,6 +108,11 @@ class SparseMap
 	 * until the map changes. */
 	std::vector<const Landmark*> resolvedLandmarks() const;
 
+	/** Scales the map by s > 0 about the world origin (monocular maps, whose unit is
+	 * arbitrary): keyframe camera centres, landmark positions and their scale-invariance
+	 * distances, and the relative poses kept for erased keyframes; orientations unchanged.
+	 * Throws std::invalid_argument unless s is finite and > 0. */
+	void rescale(double s);
 	/** Recomputes normal, distance limits and representative descriptor of a landmark. */
 	void updateLandmarkStats(LandmarkId lm);
 	/** Recomputes the covisibility edges of kf (and the reverse edges). */
@@ -158,5 +163,12 @@ class SparseMap
 
 /** Eigen position of a CPose3D translation. */
 inline Eigen::Vector3d translationOf(const mrpt::poses::CPose3D& p) { return {p.x(), p.y(), p.z()}; }
+/** The pose's translation multiplied by s, its rotation kept (a map scaled about its origin). */
+inline void scaleTranslation(mrpt::poses::CPose3D& p, double s)
+{
+	p.x(s * p.x());
+	p.y(s * p.y());
+	p.z(s * p.z());
+}
 
 }  // namespace keygrid::sfm

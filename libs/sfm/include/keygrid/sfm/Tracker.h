@@ -4,12 +4,19 @@
  * map, Ceres pose refinement; PnP-RANSAC fallback and relocalization; keyframe decisions.
  * The tracker only creates keyframes and their new landmarks; refining the map around them
  * is the LocalMapper's job.
+ *
+ * Monocular mode (TrackerOptions::monocular; Tracker_monocular.cpp): the map starts from two
+ * views (a reference frame, the following frames matched against it, TwoViewInitializer), at
+ * the scale that puts the first keyframe's median scene depth at 1; keyframes bring no
+ * landmarks of their own (the LocalMapper triangulates them) and are inserted by ORB-SLAM2's
+ * monocular rule (MonocularOptions).
  */
 #include <keygrid/core/Frame.h>
 #include <keygrid/sfm/HocFrontend.h>
 #include <keygrid/sfm/RollingShutter.h>
 #include <keygrid/sfm/SparseMap.h>
 #include <keygrid/sfm/TrackerOptions.h>
+#include <keygrid/sfm/TwoViewInitializer.h>
 
 #include <deque>
 #include <functional>
@@ -87,6 +94,16 @@ struct TrackedFrame
 	bool relocalizedByPlaceRecognition{false};
 	/** Landmarks in the map after this frame (filled by the application). */
 	std::size_t mapLandmarks{0};
+	/** Monocular map start (method Init): the first keyframe of the new map, made of the
+	 * reference frame `initialFrameIndex`; `keyframe` is the second one, this frame. */
+	bool hasInitialKeyFrame{false};
+	KeyFrameId initialKeyFrame{0};
+	std::size_t initialFrameIndex{0};
+	/** Monocular, before the map starts: what this frame did towards it (became the
+	 * reference, or why the two-view initialization failed); empty otherwise. */
+	std::string initMessage;
+	/** Monocular, before the map starts: this frame became the reference frame. */
+	bool initNewReference{false};
 };
 
 /** Place recognition for relocalization: keyframes that may show the same place as the
@@ -135,6 +152,10 @@ class Tracker
 	 * tracking went on while the loop was closed): the last frame follows its reference
 	 * keyframe. */
 	void onMapCorrected();
+	/** After the map was scaled by s about the world origin (SparseMap::rescale: a monocular
+	 * map given metric scale): the last pose, the motion model and the last frame's pose
+	 * relative to its reference keyframe scale with it. */
+	void onMapRescaled(double s);
 	const TrackerOptions& options() const { return m_opts; }
 	/** Landmarks matched as inliers in the last frame (for diagnostics and the maps). */
 	const std::vector<LandmarkId>& lastInlierLandmarks() const { return m_lastInliers; }
@@ -156,6 +177,17 @@ class Tracker
 	};
 
 	bool initialize(Current& cur, TrackedFrame& out);
+	/** Monocular map start: a reference frame, then two-view initialization with each next
+	 * frame (retried, the reference replaced when it matches too few or after
+	 * init_max_frames); true when this frame started the map. */
+	bool initializeMonocular(Current& cur, TrackedFrame& out);
+	/** The map of a successful two-view initialization: two keyframes, the triangulated
+	 * landmarks, their bundle adjustment, median depth 1; false (map untouched, reason in
+	 * out.initMessage) when too few landmarks survive. `pairs` holds the (reference, current)
+	 * keypoints of each correspondence of `r`, in its order. */
+	bool startMonocularMap(Current& cur, const TwoViewResult& r, const std::vector<std::pair<int, int>>& pairs, TrackedFrame& out);
+	/** The current frame becomes the monocular reference frame. */
+	void setMonocularReference(const Current& cur);
 	/** One tracking attempt of an initialized tracker: motion model / PnP or relocalization,
 	 * then the local map; fills out.method; true when the pose is good. */
 	bool attempt(Current& cur, TrackedFrame& out);
@@ -187,6 +219,10 @@ class Tracker
 	/** HOC update and pruning after the pose of cur is final. */
 	void updateHoc(Current& cur, TrackedFrame& out);
 	bool needKeyFrame(const Current& cur) const;
+	/** ORB-SLAM2's monocular rule: fewer tracked landmarks than keyframe_tracked_ratio x the
+	 * reference keyframe's (seen by >= keyframe_ref_min_observations keyframes), or the
+	 * keyframe timeout; and enough inliers. */
+	bool needKeyFrameMonocular(const Current& cur) const;
 	KeyFrameId createKeyFrame(const Current& cur);
 	/** A keyframe of the current frame: its time, pose, features, depth and colour image. */
 	static KeyFrame keyFrameOf(const Current& cur);
@@ -220,6 +256,23 @@ class Tracker
 	std::uint32_t m_newMapId{0};  //!< KeyFrame::mapId of the map initialize() starts
 	bool m_relocRecognized{false};  //!< the last relocalize() succeeded on a recognized place
 	double m_hocSelectionSeconds{0};  //!< CPU time of the HOC selection in the current frame
+	/** Monocular map start: the reference frame, and where each of its keypoints was last
+	 * matched (the centre of its next search window). */
+	struct MonocularReference
+	{
+		std::size_t index{0};
+		double timestamp{0};
+		cv::Mat colour;
+		FrameFeatures features;
+		std::vector<cv::Point2f> predicted;
+		/** Plane normals of the motions of the first ambiguous two-view result with this
+		 * reference (see MonocularOptions::initPlaneNormalDeg) */
+		std::vector<Eigen::Vector3d> ambiguousNormals;
+	};
+	/** An ambiguous homography result with this reference resolved by the plane the first
+	 * ambiguous result implied: the index of the candidate to take, or nullopt. */
+	std::optional<std::size_t> resolvePlaneAmbiguity(const TwoViewResult& r);
+	std::optional<MonocularReference> m_monoRef;
 };
 
 }  // namespace keygrid::sfm

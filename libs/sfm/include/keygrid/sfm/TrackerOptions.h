@@ -5,6 +5,7 @@
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/maps/HocHistogram.h>
 #include <keygrid/sfm/Matcher.h>
+#include <keygrid/sfm/MonocularOptions.h>
 #include <keygrid/sfm/PnpSolver.h>
 #include <keygrid/sfm/PoseOptimizer.h>
 
@@ -86,6 +87,12 @@ struct TrackerOptions
 	 * on an object that stood still and then moves cannot outvote the young static points
 	 * (Default: 100) */
 	int anchorMinCount{100};
+	/** A camera without depth: the map starts from two views and keyframes follow the
+	 * monocular rule (Tracker.h; options in `monocular`). Set by the application from
+	 * [slam] sensor, not a [tracker] key (Default: false) */
+	bool monocular{false};
+	/** The monocular mode's options ([monocular] section, loaded by the application). */
+	MonocularOptions mono;
 	MatcherOptions matcher;
 	PoseOptimizerOptions pose;
 	PnpOptions pnp;
@@ -93,7 +100,7 @@ struct TrackerOptions
 	 * the application; see HocFrontend.h). */
 	maps::HocOptions hoc;
 
-	/** The [tracker] keys (without [hoc], which is a section of its own). */
+	/** The [tracker] keys (without [hoc] and [monocular], which are sections of their own). */
 	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;

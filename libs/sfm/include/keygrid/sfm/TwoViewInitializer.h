@@ -111,6 +111,20 @@ enum class TwoViewFailure
 const char* toString(TwoViewFailure f);
 const char* toString(TwoViewModel m);
 
+/** A motion hypothesis that competed with the best one (TwoViewResult::candidates). */
+struct TwoViewCandidate
+{
+	RelativeMotion motion;
+	/** Per correspondence, as TwoViewResult::points_ref / triangulated */
+	std::vector<Eigen::Vector3d> points_ref;
+	std::vector<uint8_t> triangulated;
+	int good{0};  //!< points passing cheirality and reprojection
+	double parallaxDeg{0};  //!< median parallax of those [deg]
+	/** Unit normal of the plane fitted to the triangulated points (reference frame, towards
+	 * the camera): the plane a homography hypothesis implies */
+	Eigen::Vector3d planeNormal_ref{Eigen::Vector3d::Zero()};
+};
+
 struct TwoViewResult
 {
 	bool ok{false};
@@ -135,6 +149,12 @@ struct TwoViewResult
 	int numInliers{0}, numTriangulated{0};
 	/** Good points (cheirality + reprojection) of the best and second-best hypotheses */
 	int bestGood{0}, secondGood{0};
+	/** Failure Ambiguous: the hypotheses that explain the inliers about equally well, the best
+	 * (refined) first. On a plane the homography's two motions both keep every point in front
+	 * of the cameras; each implies another plane, and only the true plane stays the same from
+	 * a second current frame (see Tracker: a later frame picks the motion whose plane
+	 * normal agrees). */
+	std::vector<TwoViewCandidate> candidates;
 };
 
 class TwoViewInitializer

@@ -2,7 +2,9 @@
 /** \file SlamConfig.h
  * Everything one keygrid-slam run is configured with, loaded from one INI file.
  *
- * Sections: [slam] (mode, camera), [features], [tracker], [mapping] (local mapping and local
+ * Sections: [slam] (mode, sensor, camera), [features], [tracker], [monocular] (map start and
+ * keyframes without depth), [camera_height_scale] (monocular: metric scale from the camera's
+ * height), [mapping] (local mapping and local
  * bundle adjustment), [refinement] (final global bundle adjustment and frame re-estimation),
  * [loop_closing] (place recognition and pose graph), [maps] (how keyframes feed the maps), [floor]
  * (the floor frame every map output is written in), [store] (the session file of --map) and [MappingApplication] (the maps themselves, MRPT's
@@ -13,6 +15,7 @@
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/TrackerOptions.h>
 #include <keygrid/slam/MetricMaps.h>
+#include <keygrid/slam/MetricScale.h>
 #include <keygrid/slam/SessionRecorder.h>
 
 #include <string>
@@ -75,11 +78,26 @@ const char* toString(RunMode m);
  * "<what> '<text>' (expected sequential or threaded)" for any other text. */
 RunMode runModeFromString(const std::string& text, const std::string& what);
 
+/** The camera a run reads: RGB-D (images and depth) or monocular (images only, the depth of
+ * an RGB-D input ignored). */
+enum class Sensor
+{
+	Rgbd,
+	Monocular
+};
+/** "rgbd" or "monocular": [slam] sensor, report.json "sensor". */
+const char* toString(Sensor s);
+
 struct SlamConfig
 {
 	/** Sequential (deterministic, default for files) or threaded (pipelined stages)
 	 * (Default: sequential) */
 	RunMode mode{RunMode::Sequential};
+	/** rgbd: images and depth; monocular: images only (rawlogs of CObservationImage, TUM
+	 * folders' rgb.txt, the images of RGB-D inputs), the map starts from two views and its
+	 * scale is arbitrary ([monocular] section, doc/frontend.md "Monocular mode")
+	 * (Default: rgbd) */
+	Sensor sensor{Sensor::Rgbd};
 	/** Camera for TUM folders: preset name or INI path; "auto" (or empty) = camera.ini in the
 	 * folder, else guessed from the folder name (Default: auto) */
 	std::string camera{"auto"};
@@ -107,8 +125,10 @@ struct SlamConfig
 	maps::FloorFrameOptions floor;
 	loop::LoopClosingOptions loop;
 	SessionRecorderOptions store;
+	/** Monocular: metric scale from camera_height ([camera_height_scale]; 0 = none). */
+	MetricScaleOptions metricScale;
 
-	/** The [slam] keys (mode, camera, mapping_lag, busy_keyframe_ratio). */
+	/** The [slam] keys (mode, sensor, camera, mapping_lag, busy_keyframe_ratio). */
 	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;

@@ -53,6 +53,10 @@ struct SystemStats
 	std::size_t baDiscarded{0};
 	/** Extend mode: a map started apart from the loaded one merged into it by loop closing. */
 	std::size_t mapsMerged{0};
+	/** Monocular: frames processed until the map started, the frame that started it included
+	 * (0 while it has not started), and the index of that frame. */
+	std::size_t framesToInitialize{0};
+	std::size_t initializationFrame{0};
 };
 
 class System
@@ -134,6 +138,10 @@ class System
 	/** Keyframes in the map now (takes the map lock: safe while the threads run). */
 	std::size_t numKeyFrames() const;
 	const std::vector<sfm::TrackedFrame>& frames() const { return m_frames; }
+	/** Monocular: what the frames before the map start did (reference frames, why two-view
+	 * initialization failed, the start), at a bounded rate (slam.log); after finish() it ends
+	 * with the last message left out, if any. */
+	const std::vector<std::string>& initializationLog() const { return m_initLog; }
 	/** A snapshot of the counters (several threads update them in threaded mode). */
 	SystemStats stats() const;
 	/** In threaded mode only after finish(). */
@@ -156,6 +164,12 @@ class System
 	StageTimings& timings() { return m_timings; }
 	const StageTimings& timings() const { return m_timings; }
 	const SlamConfig& config() const { return m_cfg; }
+	/** The map is in metres: measured depth (RGB-D), or a monocular map given metric scale
+	 * from camera_height; otherwise its unit is arbitrary (a trajectory is compared with a
+	 * Sim(3) alignment). */
+	bool metricUnits() const { return m_cfg.sensor == Sensor::Rgbd || (m_metricScale && m_metricScale->metric()); }
+	/** Monocular with camera_height: the metric scale keeper; nullptr otherwise. */
+	const MetricScale* metricScale() const { return m_metricScale ? &*m_metricScale : nullptr; }
 
    private:
 	/** A new keyframe on its way through local mapping and loop closing. */
@@ -174,6 +188,14 @@ class System
 	bool mapKeyFrameConcurrently(const KeyFrameJob& job);
 	/** The counters and timings of one keyframe's local mapping. */
 	void recordLocalMapping(const sfm::LocalMappingReport& rep, double seconds);
+	/** Monocular: a tracker's initialization message into m_initLog, at a bounded rate. */
+	void logInitialization(const sfm::TrackedFrame& tf);
+	/** Monocular with camera_height, after a new keyframe (map lock held): the map rescaled
+	 * when an estimate is due and succeeds, with the tracker, the frames (`tf`, the current
+	 * one, included) and the path length. */
+	void applyMetricScale(sfm::TrackedFrame& tf);
+	/** Monocular map start: the frame that became the first keyframe references it now. */
+	void attachInitialKeyFrame(const sfm::TrackedFrame& tf);
 	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
 	 * tracker's last frame, which created the keyframe. */
 	void insertAndCloseLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
@@ -236,6 +258,11 @@ class System
 	sfm::Tracker m_tracker;
 	sfm::LocalMapper m_mapper;
 	std::vector<sfm::TrackedFrame> m_frames;
+	std::vector<std::string> m_initLog;  //!< see initializationLog()
+	std::optional<MetricScale> m_metricScale;  //!< see metricScale()
+	std::size_t m_initLogLastFrame{0};  //!< frame of the last line of m_initLog
+	std::size_t m_initLogSkipped{0};  //!< messages left out since then
+	std::string m_initLogLastMessage;  //!< the last of them
 	std::vector<std::optional<mrpt::poses::CPose3D>> m_refined;
 	std::optional<sfm::PinholeIntrinsics> m_K;
 	bool m_finished{false};

@@ -1,0 +1,76 @@
+#pragma once
+/** \file MetricScale.h
+ * Metric scale for a monocular run from the camera's known height above the floor: when the
+ * map has enough keyframes, sfm::CameraHeightScaleEstimator measures its scale (metres per map
+ * unit) and the map is rescaled by it; from then on the estimate is repeated every
+ * reestimate_every keyframes and applied again, so the map stays metric as it grows and its
+ * scale drifts. Until the first estimate succeeds it is tried at every new keyframe. The map
+ * alone is rescaled here; the caller (slam::System) moves what refers to it (tracker, frames).
+ */
+#include <keygrid/core/OptionFields.h>
+#include <keygrid/sfm/CameraHeightScale.h>
+#include <keygrid/sfm/SparseMap.h>
+
+#include <optional>
+#include <string>
+
+namespace mrpt::config
+{
+class CConfigFileBase;
+}
+
+namespace keygrid::slam
+{
+/** [camera_height_scale]: the estimator's keys and how often it runs. */
+struct MetricScaleOptions
+{
+	/** camera_height (0 = unknown: the monocular map keeps an arbitrary scale) and the floor
+	 * search (sfm::CameraHeightScaleOptions). */
+	sfm::CameraHeightScaleOptions estimator;
+	/** After the first successful estimate, estimate and rescale again every this many new
+	 * keyframes (Default: 10) */
+	int reestimateEvery{10};
+
+	bool enabled() const { return estimator.cameraHeight > 0; }
+	core::OptionFields fields();
+	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
+	void validate(const std::string& section = "camera_height_scale") const;
+};
+
+class MetricScale
+{
+   public:
+	/** Throws std::invalid_argument when the options are invalid or camera_height is 0. */
+	explicit MetricScale(const MetricScaleOptions& opts);
+
+	/** When an estimate is due (see the file comment): estimates the scale of `map` (its
+	 * keyframes and landmarks) and, when the estimate succeeds, rescales the map by it
+	 * (SparseMap::rescale) and returns the factor; nullopt when nothing was applied. The
+	 * caller holds the map's lock. */
+	std::optional<double> update(sfm::SparseMap& map);
+
+	struct Stats
+	{
+		int estimates{0};  //!< estimates run
+		int applied{0};  //!< of them, successful and applied
+		/** Product of the factors applied: metres per unit of the map as it started */
+		double totalFactor{1.0};
+		/** Factor of the last applied estimate (1: the map already was at that scale) */
+		double lastFactor{1.0};
+		std::string lastMessage;  //!< the last estimate's result text
+	};
+	const Stats& stats() const { return m_stats; }
+	/** The map is in metres: an estimate was applied. */
+	bool metric() const { return m_stats.applied > 0; }
+
+   private:
+	MetricScaleOptions m_opts;
+	sfm::CameraHeightScaleEstimator m_estimator;
+	/** Newest keyframe id at the last estimate (ids only grow: culling does not reset it) */
+	std::optional<sfm::KeyFrameId> m_lastEstimateAt;
+	Stats m_stats;
+};
+
+}  // namespace keygrid::slam

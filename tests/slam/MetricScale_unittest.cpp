@@ -1,0 +1,152 @@
+// slam::MetricScale (monocular metric scale from camera_height) on a synthetic map in map units:
+// keyframe cameras at height h_map above a floor of points, walls around. The first estimate
+// scales the map by camera_height / h_map (closed form: exact floor, exact heights), and later
+// estimates come every reestimate_every keyframes.
+#include <keygrid/slam/MetricScale.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+using namespace keygrid;
+using mrpt::poses::CPose3D;
+
+namespace
+{
+constexpr double kHeightMap = 0.5;  // camera height in map units
+constexpr double kCameraHeight = 1.3;  // [m]
+
+/** Optical frame (x right, y down, z forward) of a camera heading `yaw` about world z, pitched
+ * down by 15 deg, at (x, y, h). */
+CPose3D camera(double x, double y, double h, double yaw)
+{
+	const double pitch = 15 * M_PI / 180;
+	const Eigen::Vector3d fwd(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), -std::sin(pitch));
+	const Eigen::Vector3d right(std::sin(yaw), -std::cos(yaw), 0);
+	mrpt::math::CMatrixDouble33 R;
+	const Eigen::Vector3d down = fwd.cross(right);
+	for (int i = 0; i < 3; i++)
+	{
+		R(i, 0) = right(i);
+		R(i, 1) = down(i);
+		R(i, 2) = fwd(i);
+	}
+	mrpt::math::CVectorFixedDouble<3> t;
+	t[0] = x;
+	t[1] = y;
+	t[2] = h;
+	return CPose3D::FromRotationAndTranslation(R, t);
+}
+
+sfm::KeyFrame keyFrame(const CPose3D& pose, int keypoints)
+{
+	sfm::KeyFrame kf;
+	kf.T_world_cam = pose;
+	kf.features.keypoints.resize(static_cast<std::size_t>(keypoints));
+	kf.features.undistorted.resize(static_cast<std::size_t>(keypoints));
+	kf.features.depth.assign(static_cast<std::size_t>(keypoints), 0.f);
+	kf.features.descriptors = cv::Mat(keypoints, 32, CV_8U, cv::Scalar(0));
+	kf.features.levelScale = {1.0};
+	return kf;
+}
+
+/** Keyframe k on a circle of radius 0.4 map units around the room's centre, looking out. */
+CPose3D circlePose(int k, double height)
+{
+	const double a = 0.3 * k;
+	return camera(0.4 * std::cos(a), 0.4 * std::sin(a), height, a);
+}
+
+/** A room of 4 x 4 map units: floor points (z = 0) and wall points, observed by keyframe `kf`. */
+void addRoom(sfm::SparseMap& map, sfm::KeyFrameId kf)
+{
+	std::mt19937 rng(5);
+	// Walls start above the floor's inlier band: their feet would lift the fitted floor.
+	std::uniform_real_distribution<double> u(-2, 2), h(0.1, 1.2);
+	int kp = 0;
+	for (int i = 0; i < 1500; i++) map.addLandmark({u(rng), u(rng), 0.0}, kf, kp++);
+	for (int i = 0; i < 1000; i++)
+	{
+		const double along = u(rng);
+		const int wall = i % 4;
+		const Eigen::Vector3d p = wall == 0 ? Eigen::Vector3d(2, along, h(rng))
+								  : wall == 1 ? Eigen::Vector3d(-2, along, h(rng))
+								  : wall == 2 ? Eigen::Vector3d(along, 2, h(rng))
+											  : Eigen::Vector3d(along, -2, h(rng));
+		map.addLandmark(p, kf, kp++);
+	}
+}
+
+slam::MetricScaleOptions options()
+{
+	slam::MetricScaleOptions o;
+	o.estimator.cameraHeight = kCameraHeight;
+	o.reestimateEvery = 10;
+	return o;
+}
+}  // namespace
+
+TEST(MetricScale, RescalesTheMapToTheCameraHeightAndReestimatesEveryNKeyFrames)
+{
+	sfm::SparseMap map;
+	slam::MetricScale scale(options());
+	const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2500)).id;
+	addRoom(map, first);
+	// Fewer keyframes than min_keyframes (3): nothing is tried.
+	map.addKeyFrame(keyFrame(circlePose(1, kHeightMap), 10));
+	EXPECT_FALSE(scale.update(map).has_value());
+	EXPECT_EQ(scale.stats().estimates, 0);
+	for (int k = 2; k < 12; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
+	const auto s = scale.update(map);
+	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+	// Exact floor and heights: s = camera_height / h_map.
+	EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap) << scale.stats().lastMessage;
+	EXPECT_TRUE(scale.metric());
+	for (const auto& [id, kf] : map.keyframes()) EXPECT_NEAR(kf.T_world_cam.z(), kCameraHeight, 1e-5);
+	EXPECT_NEAR(map.landmark(map.keyframe(first).landmarks[100]).p_world.z(), 0.0, 1e-12);  // a floor point stays on z = 0
+
+	// Not due again before reestimate_every new keyframes; then the (now metric) map keeps
+	// its scale.
+	EXPECT_FALSE(scale.update(map).has_value());
+	for (int k = 12; k < 21; k++) map.addKeyFrame(keyFrame(circlePose(k, kCameraHeight), 10));
+	EXPECT_FALSE(scale.update(map).has_value());
+	map.addKeyFrame(keyFrame(circlePose(21, kCameraHeight), 10));
+	const auto again = scale.update(map);
+	ASSERT_TRUE(again.has_value()) << scale.stats().lastMessage;
+	EXPECT_NEAR(*again, 1.0, 1e-6);
+	EXPECT_EQ(scale.stats().estimates, 2);
+	EXPECT_EQ(scale.stats().applied, 2);
+	EXPECT_NEAR(scale.stats().totalFactor, kCameraHeight / kHeightMap, 1e-5);
+}
+
+TEST(MetricScale, IsRetriedAtEveryKeyFrameUntilTheFloorIsFound)
+{
+	sfm::SparseMap map;
+	slam::MetricScale scale(options());
+	// No floor yet (walls only above the cameras' horizontal): refused, the map unchanged.
+	const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 10)).id;
+	for (int i = 0; i < 10; i++) map.addLandmark({2.0, 0.1 * i, 1.0}, first, i);
+	for (int k = 1; k < 4; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
+	EXPECT_FALSE(scale.update(map).has_value());
+	EXPECT_EQ(scale.stats().estimates, 1);
+	EXPECT_FALSE(scale.metric());
+	EXPECT_NEAR(map.keyframe(first).T_world_cam.z(), kHeightMap, 1e-15);
+	// The next keyframe brings the floor: tried again at once.
+	const auto withRoom = map.addKeyFrame(keyFrame(circlePose(4, kHeightMap), 2500)).id;
+	addRoom(map, withRoom);
+	const auto s = scale.update(map);
+	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+	EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
+	EXPECT_EQ(scale.stats().estimates, 2);
+}
+
+TEST(MetricScale, NeedsACameraHeightAndValidOptions)
+{
+	EXPECT_THROW(slam::MetricScale(slam::MetricScaleOptions()), std::invalid_argument);
+	auto o = options();
+	o.reestimateEvery = 0;
+	EXPECT_THROW(slam::MetricScale{o}, std::invalid_argument);
+	EXPECT_FALSE(slam::MetricScaleOptions().enabled());
+	EXPECT_TRUE(options().enabled());
+}

@@ -1,0 +1,127 @@
+// keygrid-slam in monocular mode end to end: keygrid-sim renders the test scene room_arc as a
+// plain camera's sequence (CObservationImage rawlog, `output.sensor=monocular`), keygrid-slam
+// runs the shipped config/sim_monocular.ini on it, and the trajectory is scored against the
+// simulator's exact ground truth after a Sim(3) alignment (a monocular map has no scale).
+#include <keygrid/core/TumTrajectory.h>
+#include <keygrid/eval/TrajectoryErrors.h>
+#include <keygrid/slam/apps/SlamApp.h>
+#include <mrpt/system/filesystem.h>
+
+#include "SimSlamRun.h"
+#include "TestData.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+using namespace keygrid;
+
+TEST(MonocularSim, StartsFromTwoViewsAndTracksARenderedSequenceWithinOnePercentOfItsPath)
+{
+	const std::string dir = test::scratchDir("monocular_sim");
+	const auto run = test::renderAndRunSlam(
+		dir, "--scene " + test::dataDir() + "/sim/room_arc.ini --set 'output.sensor=monocular' --voxel-resolution 0 --floorplan-resolution 0",
+		true, "config/sim_monocular.ini");
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	const auto& o = run.options;
+	const auto& r = run.result;
+	ASSERT_TRUE(r.error.empty()) << r.error;
+	EXPECT_EQ(r.frames, 90u);
+
+	const auto report = nlohmann::json::parse(test::readTextFile(o.output + "/report.json"));
+	EXPECT_EQ(report.at("sensor"), "monocular");
+	EXPECT_EQ(report.at("scale_source"), "none");
+	EXPECT_EQ(report.at("ate_alignment"), "sim3");
+	ASSERT_TRUE(report.at("initialization").at("started").get<bool>());
+	const auto startFrame = report.at("initialization").at("frame").get<std::size_t>();
+	// The camera starts facing a wall (a plane: the homography's two motions stay ambiguous)
+	// and starts the map once the box beside it gives depth structure, about frame 35.
+	EXPECT_LT(startFrame, 45u);
+	// Every frame after the start is tracked.
+	EXPECT_EQ(r.tracked, r.frames - startFrame);
+	const std::string log = test::readTextFile(o.output + "/slam.log");
+	EXPECT_NE(log.find("map started"), std::string::npos) << log;
+
+	// trajectory.txt holds the frames from the reference frame (the first keyframe) on; the
+	// ATE after a Sim(3) alignment is below 1 % of the path they travel (the issue's target).
+	const auto est = core::readTumTrajectory(o.output + "/trajectory.txt");
+	const auto gt = core::readTumTrajectory(dir + "/seq/groundtruth.txt");
+	ASSERT_GE(est.size(), r.frames - startFrame);
+	double travelled = 0;
+	for (std::size_t i = 1; i < gt.size(); i++)
+		if (gt[i - 1].t >= est.front().t - 1e-6)
+			travelled += (gt[i].T_world_cam.translation() - gt[i - 1].T_world_cam.translation()).norm();
+	ASSERT_TRUE(r.ateRmse.has_value());
+	EXPECT_LT(*r.ateRmse, 0.01 * travelled) << "path " << travelled << " m";
+}
+
+// With the camera's height (1.30 m in the test scenes) the monocular map is rescaled to metres
+// from its floor points: room_floor_view's camera looks down at the floor, the trajectory is
+// compared without a scale (SE(3)), and the scale a Sim(3) alignment would still apply is the
+// remaining scale error.
+TEST(MonocularSim, CameraHeightGivesAMetricTrajectory)
+{
+	const std::string dir = test::scratchDir("monocular_sim_height");
+	test::SimSlamRun run;
+	run.rendered = test::runCommand(
+					   test::toolPath("keygrid-sim") + " --quiet --scene " + test::dataDir() +
+						   "/sim/room_floor_view.ini --set 'output.sensor=monocular' --voxel-resolution 0 --floorplan-resolution 0 --output " +
+						   dir + "/seq",
+					   &run.simLog) == 0;
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	auto& o = run.options;
+	o.configPath = test::sourceDir() + "/config/sim_monocular.ini";
+	o.set = "camera_height_scale.camera_height=1.30";
+	o.input = dir + "/seq/sequence.rawlog";
+	o.output = dir + "/out";
+	o.groundTruth = dir + "/seq/groundtruth.txt";
+	o.quiet = true;
+	const auto r = slam::runSlam(o);
+	ASSERT_TRUE(r.error.empty()) << r.error;
+
+	const auto report = nlohmann::json::parse(test::readTextFile(o.output + "/report.json"));
+	ASSERT_EQ(report.at("scale_source"), "camera_height") << report.at("camera_height_scale").dump();
+	EXPECT_EQ(report.at("ate_alignment"), "se3");
+	const auto startFrame = report.at("initialization").at("frame").get<std::size_t>();
+	EXPECT_EQ(r.tracked, r.frames - startFrame);
+
+	const auto est = core::readTumTrajectory(o.output + "/trajectory.txt");
+	const auto gt = core::readTumTrajectory(dir + "/seq/groundtruth.txt");
+	double travelled = 0;
+	for (std::size_t i = 1; i < gt.size(); i++)
+		if (gt[i - 1].t >= est.front().t - 1e-6) travelled += (gt[i].T_world_cam.translation() - gt[i - 1].T_world_cam.translation()).norm();
+	ASSERT_TRUE(r.ateRmse.has_value());
+	// The issue's bound for metric monocular runs: 1.5 % of the path, without a scale.
+	EXPECT_LT(*r.ateRmse, 0.015 * travelled) << "path " << travelled << " m";
+	// The scale left: the floor of this short sequence is seen by a few keyframes, its points
+	// triangulated over short baselines (doc/frontend.md "Monocular mode"): 5 %, not the 2 %
+	// the issue asks of the longer benchmark loops.
+	eval::TrajectoryErrorOptions eo;
+	eo.withScale = true;
+	const auto sim3 = eval::evaluateTrajectory(gt, est, eo);
+	EXPECT_NEAR(sim3.alignment.s, 1.0, 0.05);
+}
+
+// A real sequence too short to start a monocular map (TUM fr1_desk, 9 frames, its depth
+// ignored): the run succeeds without a pose, report.json says the map never started, and
+// slam.log ends with the initializer's last reason although the rate bound left it out.
+TEST(MonocularSim, ASequenceThatNeverStartsAMapSaysWhy)
+{
+	KEYGRID_SKIP_WITHOUT_SHARED_DATA("tum_fr1_desk_9frames");
+	slam::SlamRunOptions o;
+	o.configPath = test::sourceDir() + "/config/tum_fr1.ini";
+	o.set = "slam.sensor=monocular";
+	o.input = test::sharedDataDir() + "/tum_fr1_desk_9frames";
+	o.output = test::scratchDir("monocular_never") + "/out";
+	o.quiet = true;
+	const auto r = slam::runSlam(o);
+	ASSERT_TRUE(r.error.empty()) << r.error;
+	EXPECT_EQ(r.frames, 9u);
+	EXPECT_EQ(r.tracked, 0u);
+	const auto report = nlohmann::json::parse(test::readTextFile(o.output + "/report.json"));
+	EXPECT_FALSE(report.at("initialization").at("started").get<bool>());
+	EXPECT_EQ(report.at("sensor"), "monocular");
+	const std::string log = test::readTextFile(o.output + "/slam.log");
+	EXPECT_NE(log.find("frame 0: reference frame of the map start"), std::string::npos) << log;
+	EXPECT_NE(log.find("frame 8 with reference frame"), std::string::npos) << log;
+	EXPECT_NE(log.find("messages left out before]"), std::string::npos) << log;
+}
