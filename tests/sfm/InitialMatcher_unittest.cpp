@@ -94,7 +94,7 @@ TEST(InitialMatcher, SearchesOnlyInsideTheWindow)
 	predicted = ref.undistorted;
 	EXPECT_EQ(sfm::searchForInitialization(ref, cur, predicted, o, refToCur), static_cast<int>(cur.size()));
 	for (std::size_t i = 0; i < ref.size(); i++)
-		if (refToCur[i] >= 0) EXPECT_EQ(source[refToCur[i]], static_cast<int>(i));
+		if (refToCur[i] >= 0) { EXPECT_EQ(source[refToCur[i]], static_cast<int>(i)); }
 }
 
 TEST(InitialMatcher, DropsMatchesWithAnInconsistentOrientationChange)

@@ -188,7 +188,7 @@ TEST(TrackerMonocular, APureRotationNeverStartsAMapAndTheReferenceIsRenewed)
 		const auto tf = tracker.track(m.frame, std::move(m.features));
 		ASSERT_FALSE(tf.tracked) << "frame " << i;
 		EXPECT_EQ(tf.initNewReference, i % 8 == 0) << "frame " << i << ": " << tf.initMessage;
-		if (i % 8 != 0) EXPECT_NE(tf.initMessage.find("parallax"), std::string::npos) << tf.initMessage;
+		if (i % 8 != 0) { EXPECT_NE(tf.initMessage.find("parallax"), std::string::npos) << tf.initMessage; }
 	}
 	EXPECT_EQ(map.numKeyFrames(), 0u);
 	EXPECT_EQ(tracker.state(), sfm::TrackingState::NotInitialized);
