@@ -1,0 +1,136 @@
+#!/usr/bin/env bash
+# Monocular mode ([slam] sensor = monocular): keygrid-slam on images alone, per case without and
+# with the camera's height above the floor ([camera_height_scale] camera_height). Cases:
+#   room    config/sim/room_loop.ini rendered as a plain camera (camera at 1.30 m)
+#   office  config/sim/office_loop.ini rendered the same way (camera at 1.40 m; 3300 frames)
+#   fr1     ../shared/data/tum_fr1_rpy_first250 with its depth ignored (no height: hand-held)
+#   desk    ../shared/data/tum_fr1_desk_9frames with its depth ignored
+# Prints per run: the frame the map started at, frames tracked after it, the ATE of the tracked
+# frames after Sim(3) alignment and as a share of the ground-truth path they cover, the ATE after SE(3) alignment
+# (with a height: the map is metric), the scale error (Sim(3) alignment scale - 1) and the
+# frame rate.
+# Renderings are made once per --out folder; the TUM cases are skipped when their data is absent.
+#
+#   tests/benchmarks/slam/monocular.sh [--build DIR] [--out DIR] [--cases "room office fr1 desk"] [--help]
+# Results: doc/evaluation.md, "Monocular mode".
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(cd "$here/../../.." && pwd)"
+build="$root/build"
+out=/tmp/keygrid_monocular
+cases="room office fr1 desk"
+data="$root/../shared/data"
+usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; }
+die() { echo "monocular.sh: error: $*" >&2; exit 2; }
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --help|-h) usage; exit 0 ;;
+  esac
+  [ $# -ge 2 ] || die "missing value after $1 (see --help)"
+  case "$1" in
+    --build) build="$2" ;;
+    --out) out="$2" ;;
+    --cases) cases="$2" ;;
+    *) die "unknown argument '$1' (see --help)" ;;
+  esac
+  shift 2
+done
+build="$(cd "$build" 2>/dev/null && pwd)" || die "no build folder $build"
+for t in keygrid-sim keygrid-slam keygrid-eval; do
+  [ -x "$build/bin/$t" ] || die "$build/bin/$t not found (build it, or pass --build)"
+done
+mkdir -p "$out" || die "cannot create $out"
+
+# render NAME SCENE -> $out/sim/NAME (once)
+render() {
+  local dir="$out/sim/$1"
+  if [ ! -f "$dir/groundtruth.txt" ]; then
+    echo "== rendering $1 as a plain camera -> $dir" >&2
+    rm -rf "$dir"
+    "$build/bin/keygrid-sim" --quiet --scene "$root/config/sim/$2.ini" --output "$dir" \
+      --set 'output.sensor=monocular' >"$out/render_$1.log" 2>&1 || die "keygrid-sim failed: $out/render_$1.log"
+  fi
+  echo "$dir"
+}
+
+# run TAG CONFIG INPUT GT HEIGHT [SET]: one keygrid-slam run and its table row
+run() {
+  local tag="$1" cfg="$2" input="$3" gt="$4" height="$5" set="${6:-}"
+  local dir="$out/run_$tag"
+  rm -rf "$dir"; mkdir -p "$dir"
+  local overrides="slam.sensor=monocular"
+  [ "$height" != 0 ] && overrides="$overrides; camera_height_scale.camera_height=$height"
+  [ -n "$set" ] && overrides="$overrides; $set"
+  echo "== $tag: keygrid-slam -> $dir" >&2
+  "$build/bin/keygrid-slam" --quiet --config "$cfg" --input "$input" --gt "$gt" --output "$dir" \
+    --set "$overrides" >"$dir/slam.log" 2>&1 || { echo "| $tag | keygrid-slam failed: $dir/slam.log |"; return; }
+  # The poses of tracked frames only (frames.csv): a lost frame's pose is a guess.
+  /usr/bin/python3 - "$dir/frames.csv" "$dir/trajectory.txt" "$dir/trajectory_tracked.txt" <<'PY'
+import csv, os, sys
+frames, traj, out = sys.argv[1:4]
+tracked = set()
+if os.path.exists(frames):
+    for row in csv.DictReader(open(frames)):
+        if row["tracked"] == "1": tracked.add(round(float(row["timestamp"]), 4))
+with open(out, "w") as f:
+    for line in (open(traj) if os.path.exists(traj) else []):
+        if line.startswith("#") or round(float(line.split()[0]), 4) in tracked: f.write(line)
+PY
+  local sim3="" se3=""
+  if grep -qv '^#' "$dir/trajectory_tracked.txt"; then
+    sim3="$("$build/bin/keygrid-eval" --gt "$gt" --est "$dir/trajectory_tracked.txt" --sim3 2>/dev/null || true)"
+    se3="$("$build/bin/keygrid-eval" --gt "$gt" --est "$dir/trajectory_tracked.txt" 2>/dev/null || true)"
+  fi
+  /usr/bin/python3 - "$dir/report.json" "$gt" "$tag" "$height" "$sim3" "$se3" "$dir/trajectory_tracked.txt" <<'PY'
+import json, math, os, re, sys
+report, gt, tag, height, sim3, se3, traj = sys.argv[1:8]
+r = json.load(open(report))
+def rows(path):
+    if not os.path.exists(path): return []
+    return [list(map(float, l.split()[:4])) for l in open(path) if l.strip() and not l.startswith("#")]
+# Path length of the ground truth over the time the tracked poses cover.
+est = rows(traj)
+t0, t1 = (est[0][0], est[-1][0]) if est else (0.0, -1.0)
+pts = [g[1:4] for g in rows(gt) if t0 - 0.02 <= g[0] <= t1 + 0.02]
+path = sum(math.dist(a, b) for a, b in zip(pts, pts[1:])) or float("nan")
+def ate(text):
+    m = re.search(r"ATE rmse ([0-9.eE+-]+) m", text)
+    return float(m.group(1)) if m else float("nan")
+init = r.get("initialization", {})
+start = init.get("frame")
+tracked_after = r["tracked"] if start is not None else 0
+after = r["frames"] - start if start is not None else 0
+m = re.search(r"Sim\(3\) alignment scale ([0-9.eE+-]+)", sim3)
+scale = float(m.group(1)) if m else float("nan")
+a_sim3, a_se3 = ate(sim3), ate(se3)
+scale_err = f"{100 * abs(scale - 1):.2f} %" if height != "0" and scale == scale else "-"
+se3_text = f"{1000 * a_se3:.1f} mm = {100 * a_se3 / path:.2f} %" if height != "0" and a_se3 == a_se3 else "-"
+sim3_text = f"{1000 * a_sim3:.1f} mm = {100 * a_sim3 / path:.2f} %" if a_sim3 == a_sim3 else "-"
+print(f"| {tag} | {height if height != '0' else '-'} | {start if start is not None else 'never'} "
+      f"| {tracked_after} / {after} | {sim3_text} | {se3_text} | {scale_err} | {r.get('fps', 0):.1f} | {path:.2f} m |")
+PY
+}
+
+echo "| run | camera_height [m] | map start (frame) | tracked after it | ATE, Sim(3) (share of the path) | ATE, SE(3) | scale error | fps | ground-truth path |"
+echo "|---|---|---|---|---|---|---|---|---|"
+mono="$root/config/sim_monocular.ini"
+for c in $cases; do
+  case "$c" in
+    room)
+      d="$(render room_loop room_loop)"
+      run room_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0
+      run room_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.30 ;;
+    office)
+      d="$(render office_loop office_loop)"
+      run office_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0
+      run office_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.40 ;;
+    fr1|desk)
+      seq=tum_fr1_rpy_first250; [ "$c" = desk ] && seq=tum_fr1_desk_9frames
+      if [ -f "$data/$seq/groundtruth.txt" ]; then
+        run "$seq" "$root/config/tum_fr1.ini" "$data/$seq" "$data/$seq/groundtruth.txt" 0
+      else
+        echo "monocular.sh: $data/$seq not found: case $c skipped" >&2
+      fi ;;
+    *) die "unknown case '$c' (room office fr1 desk)" ;;
+  esac
+done
