@@ -1,5 +1,6 @@
 #include "DescriptorMetric.h"
 
+#include <keygrid/core/NearestTwo.h>
 #include <keygrid/loop/DirectIndexMatcher.h>
 
 #include <algorithm>
@@ -27,22 +28,15 @@ std::vector<DescriptorMatch> match(
 		{
 			for (int ia : itA->second)
 			{
-				double best = std::numeric_limits<double>::infinity(), second = best;
-				int bestB = -1;
+				core::NearestTwo<double> nearest;
 				for (int ib : itB->second)
 				{
-					double d = m.distance(A.ptr(ia), B.ptr(ib));
-					if (squared) d = std::sqrt(d);
-					if (d < best)
-					{
-						second = best;
-						best = d;
-						bestB = ib;
-					}
-					else if (d < second)
-						second = d;
+					const double d = m.distance(A.ptr(ia), B.ptr(ib));
+					nearest.add(squared ? std::sqrt(d) : d, ib);
 				}
-				if (bestB < 0 || best > o.maxDistance || !(best < o.ratio * second)) continue;
+				const int bestB = nearest.index;
+				const double best = nearest.best;
+				if (bestB < 0 || best > o.maxDistance || !(best < o.ratio * nearest.second)) continue;
 				auto& slot = bestForB[static_cast<std::size_t>(bestB)];
 				if (slot.a < 0 || best < slot.distance) slot = DescriptorMatch{ia, bestB, best};
 			}

@@ -1,3 +1,4 @@
+#include <keygrid/core/NearestTwo.h>
 #include <keygrid/sfm/InitialMatcher.h>
 
 #include <algorithm>
@@ -63,21 +64,11 @@ int searchForInitialization(
 		const int level = ref.keypoints[i].octave;
 		// The window bounds the image motion, which does not depend on the level.
 		cur.featuresInArea(predicted[i].x, predicted[i].y, o.windowPx, std::max(0, level - 1), level + 1, area);
-		float best = std::numeric_limits<float>::max(), second = best;
-		int bestIdx = -1;
-		for (int j : area)
-		{
-			const float d = descriptorDistance(ref.descriptors, static_cast<int>(i), cur.descriptors, j);
-			if (d < best)
-			{
-				second = best;
-				best = d;
-				bestIdx = j;
-			}
-			else if (d < second)
-				second = d;
-		}
-		if (bestIdx < 0 || best > o.maxDistance || !(best < o.ratio * second)) continue;
+		core::NearestTwo<float> nearest;
+		for (int j : area) nearest.add(descriptorDistance(ref.descriptors, static_cast<int>(i), cur.descriptors, j), j);
+		const int bestIdx = nearest.index;
+		const float best = nearest.best;
+		if (bestIdx < 0 || best > o.maxDistance || !(best < o.ratio * nearest.second)) continue;
 		if (curToRef[bestIdx] >= 0)
 		{
 			if (curBest[bestIdx] <= best) continue;  // that keypoint has a closer reference keypoint

@@ -1,3 +1,4 @@
+#include <keygrid/core/NearestTwo.h>
 #include <keygrid/sfm/Matcher.h>
 #include <opencv2/features2d.hpp>
 
@@ -111,21 +112,11 @@ std::vector<std::pair<int, int>> matchSubsetBruteForce(
 	if (ia.empty() || nb == 0) return out;
 	for (int i : ia)
 	{
-		int best = -1;
-		float d1 = std::numeric_limits<float>::max(), d2 = d1;
-		for (int j = 0; j < nb; j++)
-		{
-			const float d = descriptorDistance(a.descriptors, i, b.descriptors, j);
-			if (d < d1)
-			{
-				d2 = d1;
-				d1 = d;
-				best = j;
-			}
-			else if (d < d2)
-				d2 = d;
-		}
-		if (d1 > maxDist || (nb > 1 && d1 > ratio * d2)) continue;
+		core::NearestTwo<float> nearest;
+		for (int j = 0; j < nb; j++) nearest.add(descriptorDistance(a.descriptors, i, b.descriptors, j), j);
+		const int best = nearest.index;
+		const float d1 = nearest.best;
+		if (d1 > maxDist || (nb > 1 && d1 > ratio * nearest.second)) continue;
 		// Mutual best: b's keypoint has no closer keypoint in a (nor an equal one before i).
 		bool mutual = true;
 		for (int k = 0; k < na && mutual; k++)

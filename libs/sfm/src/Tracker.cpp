@@ -313,9 +313,16 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 		if (f.depth[i] > 0)
 			m_map.addLandmark(m_K.backProject(f.undistorted[i].x, f.undistorted[i].y, f.depth[i]), id, static_cast<int>(i));
 	if (m_hoc) m_hoc->confirmInitialMap(m_map, id);
-	m_refKf = id;
+	startTrackingOnNewMap(cur, out, {id}, static_cast<int>(m_map.numLandmarks()));
+	return true;
+}
+
+void Tracker::startTrackingOnNewMap(const Current& cur, TrackedFrame& out, std::vector<KeyFrameId> localKfs, int landmarks)
+{
+	const KeyFrameId newest = localKfs.front();
+	m_refKf = newest;
 	m_lastKfFrame = cur.frame->index;
-	m_localKfs = {id};
+	m_localKfs = std::move(localKfs);
 	m_lastPose = cur.T_world_cam;
 	m_lastTimestamp = cur.frame->timestamp;
 	m_velocity.reset();
@@ -323,14 +330,13 @@ bool Tracker::initialize(Current& cur, TrackedFrame& out)
 	m_state = TrackingState::Ok;
 	out.tracked = true;
 	out.method = TrackingMethod::Init;
-	out.inliers = out.matches = static_cast<int>(m_map.numLandmarks());
+	out.inliers = out.matches = landmarks;
 	out.newKeyFrame = true;
-	out.keyframe = id;
+	out.keyframe = newest;
 	out.T_world_cam = cur.T_world_cam;
-	out.reference = id;
+	out.reference = newest;
 	out.hasReference = true;
 	m_lastInliers.clear();
-	return true;
 }
 
 std::vector<ProjectedLandmark> Tracker::projectLocalLandmarks(Current& cur, bool forLocalMap)

@@ -232,26 +232,10 @@ bool Tracker::startMonocularMap(Current& cur, const TwoViewResult& r, const std:
 		static_cast<int>(depths.size()), r.parallaxDeg);
 	out.initMessage = text;
 	cur.T_world_cam = kf2.T_world_cam;
-	m_refKf = id2;
-	m_lastKfFrame = cur.frame->index;
-	m_localKfs = {id2, id1};
-	m_lastPose = cur.T_world_cam;
-	m_lastTimestamp = cur.frame->timestamp;
-	m_velocity.reset();
-	m_velocityDt = 0;
-	m_state = TrackingState::Ok;
-	out.tracked = true;
-	out.method = TrackingMethod::Init;
-	out.inliers = out.matches = static_cast<int>(depths.size());
-	out.newKeyFrame = true;
-	out.keyframe = id2;
+	startTrackingOnNewMap(cur, out, {id2, id1}, static_cast<int>(depths.size()));
 	out.hasInitialKeyFrame = true;
 	out.initialKeyFrame = id1;
 	out.initialFrameIndex = ref.index;
-	out.T_world_cam = cur.T_world_cam;
-	out.reference = id2;
-	out.hasReference = true;
-	m_lastInliers.clear();
 	m_monoRef.reset();
 	return true;
 }

@@ -181,6 +181,10 @@ class Tracker
 	 * frame (retried, the reference replaced when it matches too few or after
 	 * init_max_frames); true when this frame started the map. */
 	bool initializeMonocular(Current& cur, TrackedFrame& out);
+	/** After a map start: tracking goes on from cur (its pose T_world_cam set) with the local
+	 * keyframes `localKfs`, the newest first (it becomes the reference keyframe), and no motion
+	 * model yet; out reports the start with `landmarks` as its matches and inliers. */
+	void startTrackingOnNewMap(const Current& cur, TrackedFrame& out, std::vector<KeyFrameId> localKfs, int landmarks);
 	/** The map of a successful two-view initialization: two keyframes, the triangulated
 	 * landmarks, their bundle adjustment, median depth 1; false (map untouched, reason in
 	 * out.initMessage) when too few landmarks survive. `pairs` holds the (reference, current)
