@@ -167,8 +167,10 @@ TEST(CISMOccupancyGrid2D, OptionsSaveLoadRoundTripAndErrorsNameTheKey)
 	EXPECT_EQ(b.rayTraversal, CISMOccupancyGrid2D::RayTraversal::AntiAliased);
 	EXPECT_EQ(b.floorRansac.iterations, 77);
 	EXPECT_NEAR((b.T_world_floor - a.T_world_floor).translation().norm(), 0.0, 1e-6);
-	EXPECT_EQ(b.floorUpHint.y, 0.5);
-	EXPECT_EQ(b.floorUpHint.z, 1.0 / 3.0);
+	// TVector3D is a packed struct: copy its fields before gtest binds them to references.
+	const double upY = b.floorUpHint.y, upZ = b.floorUpHint.z;
+	EXPECT_EQ(upY, 0.5);
+	EXPECT_EQ(upZ, 1.0 / 3.0);
 	EXPECT_TRUE(b.estimateFloorFromDepth);
 	EXPECT_EQ(b.freeSpaceModel, CISMOccupancyGrid2D::FreeSpaceModel::Paper);
 
