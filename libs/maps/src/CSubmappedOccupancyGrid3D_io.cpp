@@ -3,12 +3,12 @@
  * Versioned serialization, OctoMap .bt and PLY exports, 3D visualization.
  */
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
+#include <keygrid/maps/OctomapBinaryWriter.h>
 #include <mrpt/math/CMatrixFixed.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CPointCloud.h>
 #include <mrpt/opengl/CSetOfObjects.h>
 #include <mrpt/serialization/CArchive.h>
-#include <octomap/OcTree.h>
 
 #include <algorithm>
 #include <fstream>
@@ -276,47 +276,25 @@ void forEachResampled(const VoxelBlockGrid& g, const mrpt::poses::CPose3D& T_out
 
 void CSubmappedOccupancyGrid3D::saveAsOctomapBinary(const std::string& path, const maps::ExportFrame& frame) const
 {
-	const VoxelBlockGrid g = fusedGrid();
-	octomap::OcTree tree(m_resolution);
-	constexpr int32_t kHalf = 32768;  // OcTree key of coordinate x is floor(x / res) + 32768
+	maps::OctomapBinaryWriter bt;
 	std::size_t outside = 0;
-	auto put = [&](const VoxelIndex& vi, const Voxel& v) {
-		if (vi.x < -kHalf || vi.x >= kHalf || vi.y < -kHalf || vi.y >= kHalf || vi.z < -kHalf ||
-			vi.z >= kHalf)
-		{
-			++outside;
-			return;
-		}
-		const octomap::OcTreeKey key(static_cast<octomap::key_type>(vi.x + kHalf),
-			static_cast<octomap::key_type>(vi.y + kHalf), static_cast<octomap::key_type>(vi.z + kHalf));
-		// OctoMap calls log-odds >= 0 occupied, keygrid > 0: keep p = 0.5 exactly free.
-		const float L = v.logOdds > 0.0f ? v.logOdds : std::min(v.logOdds, -1e-4f);
-		tree.setNodeValue(key, L, true);
-	};
-	if (frame.isIdentity())
-		g.forEachKnown(put);
-	else
-		forEachResampled(g, frame.T_out_world, put);
+	{
+		const VoxelBlockGrid g = fusedGrid();
+		// OctoMap calls log-odds >= 0 occupied, keygrid > 0: p = 0.5 stays free.
+		auto put = [&](const VoxelIndex& vi, const Voxel& v) {
+			if (!bt.add(vi.x, vi.y, vi.z, v.logOdds > 0.0f)) ++outside;
+		};
+		if (frame.isIdentity())
+			g.forEachKnown(put);
+		else
+			forEachResampled(g, frame.T_out_world, put);
+	}
 	if (outside > 0)
 		throw std::runtime_error(
 			"saveAsOctomapBinary: " + std::to_string(outside) +
 			" voxels lie outside the OcTree key range (+-32768 voxels)");
-	tree.updateInnerOccupancy();
-	// What AbstractOccupancyOcTree::writeBinary writes, which then prints " done." on stderr
-	// (noise in a quiet run): the tree at maximum likelihood, pruned, after OctoMap's header: a
-	// first line OctoMap checks, then
-	// keyword lines; it skips lines starting with '#' (AbstractOcTree::readHeader), so the
-	// frame goes in as the second line.
-	tree.toMaxLikelihood();
-	tree.prune();
-	std::ostringstream bt;
-	bt << "# Octomap OcTree binary file\n";
-	if (!frame.comment.empty()) bt << "# " << frame.comment << "\n";
-	bt << "# (feel free to add / change comments, but leave the first line as it is!)\n#\n"
-	   << "id " << tree.getTreeType() << "\nsize " << tree.size() << "\nres " << tree.getResolution() << "\ndata\n";
-	tree.writeBinaryData(bt);
-	if (!bt) throw std::runtime_error("saveAsOctomapBinary: cannot serialize the tree");
-	core::writeFileAtomically(path, bt.str());
+	// The frame goes in as a comment line of the header, which OctoMap's reader skips.
+	core::writeFileAtomically(path, [&](std::ostream& f) { bt.write(f, m_resolution, frame.comment); });
 }
 
 void CSubmappedOccupancyGrid3D::saveOccupiedAsPly(const std::string& path, const maps::ExportFrame& frame) const
