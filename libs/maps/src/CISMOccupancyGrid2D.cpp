@@ -82,7 +82,7 @@ void CISMOccupancyGrid2D::resetBand()
 	m_bandSlices = bandSlicesWanted();
 	const size_t n = m_logOdds.size() * static_cast<size_t>(m_bandSlices + 1);
 	m_band.assign(n, 0.0f);
-	m_bandScratch.assign(n, 0.0f);
+	m_bandScratch.clear();  // sized per keyframe window (integrateRays)
 	m_bandTouched.clear();
 }
 
@@ -133,8 +133,6 @@ void CISMOccupancyGrid2D::growToContain(double x0, double x1, double y0, double 
 			std::copy_n(&m_band[static_cast<size_t>(cy) * m_sizeX * stride], static_cast<size_t>(m_sizeX) * stride,
 				&band[(static_cast<size_t>(cy + addBottom) * nx + addLeft) * stride]);
 		m_band.swap(band);
-		m_bandScratch.assign(m_band.size(), 0.0f);
-		m_bandTouched.clear();
 	}
 	m_xMin -= addLeft * m_resolution;
 	m_yMin -= addBottom * m_resolution;

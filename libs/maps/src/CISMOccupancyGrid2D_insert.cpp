@@ -198,6 +198,15 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 			s = combine(s, inc);
 	};
 	const size_t stride = static_cast<size_t>(m_bandSlices + 1);
+	/* heightBand: the slice updates are summed in a scratch window over the cells this
+	 * keyframe's rays can reach (their bounding box and the one-cell reach of the traversals),
+	 * not over the whole grid. */
+	const BandWindow win = band ? bandWindow(bx0, bx1, by0, by1) : BandWindow{};
+	if (band && m_bandScratch.size() < win.cells() * stride) m_bandScratch.assign(win.cells() * stride, 0.0f);
+	auto windowBase = [&](int cx, int cy) {
+		if (!win.contains(cx, cy)) throw std::logic_error("CISMOccupancyGrid2D: a ray left its scratch window");
+		return win.index(cx, cy) * stride;
+	};
 	auto touchSlot = [&](size_t idx, float inc) {
 		float& s = m_bandScratch[idx];
 		if (s == 0.0f)
@@ -215,7 +224,7 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 	auto touchBand = [&](int cx, int cy, float za, float zb, float inc, uint64_t extra) {
 		if (!inside(cx, cy) || inc == 0.0f) return;
 		if (za > zb) std::swap(za, zb);
-		const size_t base = (static_cast<size_t>(cx) + static_cast<size_t>(cy) * m_sizeX) * stride;
+		const size_t base = windowBase(cx, cy);
 		if (inc < 0.0f && za < hMin && zb >= -fTol) touchSlot(base, inc);
 		if (zb >= hMin && za <= hMax)
 		{
@@ -304,17 +313,18 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 		for (size_t cell : m_freeTouched)
 		{
 			FreeColumn& c = m_freeColumns[cell];
-			const size_t base = cell * stride;
+			const size_t base = windowBase(static_cast<int>(cell % static_cast<size_t>(m_sizeX)), static_cast<int>(cell / static_cast<size_t>(m_sizeX)));
 			if (c.clearance) touchSlot(base, lFree);
 			for (uint64_t m = c.slices; m; m &= m - 1) touchSlot(base + 1 + static_cast<size_t>(__builtin_ctzll(m)), lFree);
 			c = FreeColumn{};
 		}
 		m_freeTouched.clear();
-		for (size_t idx : m_bandTouched)
+		for (size_t w : m_bandTouched)
 		{
-			m_band[idx] = std::clamp(m_band[idx] + m_bandScratch[idx], lo, hi);
-			m_bandScratch[idx] = 0.0f;
-			const size_t cell = idx / stride;
+			const size_t cell = win.gridCell(w / stride, static_cast<size_t>(m_sizeX));
+			const size_t idx = cell * stride + w % stride;
+			m_band[idx] = std::clamp(m_band[idx] + m_bandScratch[w], lo, hi);
+			m_bandScratch[w] = 0.0f;
 			if (m_scratch[cell] == 0.0f)
 			{
 				m_scratch[cell] = 1.0f;  // marks the cell for the column update below
@@ -446,13 +456,19 @@ std::vector<TPoint3Df> CISMOccupancyGrid2D::reduceDepth(
 			}
 		}
 	}
+	// Kept with the keyframe until the map ends: allocated at its exact size.
+	const auto kept = [&](const Acc& a) { return a.obstacles >= o.minPointsPerCell; };
+	size_t count = 0;
+	for (const Acc& a : acc) count += (kept(a) ? 1u : 0u) + (a.hasFloor ? 1u : 0u);
+	for (const auto& sp : slicePoints) count += kept(acc[sp.first]) ? 1u : 0u;
+	out.reserve(count);
 	for (const Acc& a : acc)
 	{
-		if (a.obstacles >= o.minPointsPerCell) out.push_back(a.obstacle);
+		if (kept(a)) out.push_back(a.obstacle);
 		if (a.hasFloor) out.push_back(a.floor);
 	}
 	for (const auto& [ai, p] : slicePoints)
-		if (acc[ai].obstacles >= o.minPointsPerCell) out.push_back(p);
+		if (kept(acc[ai])) out.push_back(p);
 	return out;
 }
 
@@ -522,6 +538,16 @@ bool CISMOccupancyGrid2D::internal_insertObservation(
 	const CPose3D T_world_robot = robotPose ? *robotPose : CPose3D();
 	const CPose3D T_world_cam = core::cameraPoseFromSensorPose(T_world_robot + o->sensorPose);
 	return insertKeyframeDepth(m_nextAutoKeyframeId++, T_world_cam, *o);
+}
+
+CISMOccupancyGrid2D::BandWindow CISMOccupancyGrid2D::bandWindow(double x0, double x1, double y0, double y1) const
+{
+	// A traversal visits the cells along its segment and one neighbour across it (anti-aliased
+	// lines); its end cells are rounded from cell coordinates: two cells of margin cover both.
+	constexpr int kMargin = 2;
+	const int cx0 = std::max(0, x2idx(x0) - kMargin), cx1 = std::min(m_sizeX - 1, x2idx(x1) + kMargin);
+	const int cy0 = std::max(0, y2idx(y0) - kMargin), cy1 = std::min(m_sizeY - 1, y2idx(y1) + kMargin);
+	return BandWindow{cx0, cy0, cx1 - cx0 + 1, cy1 - cy0 + 1};
 }
 
 double CISMOccupancyGrid2D::applyTrajectoryCorrection(const std::map<uint64_t, CPose3D>& newPoses)

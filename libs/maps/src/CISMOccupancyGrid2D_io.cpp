@@ -155,7 +155,7 @@ void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
 				m_bandSlices = m_band.empty() ? 0 : slices;
 			}
 			m_scratch.assign(m_logOdds.size(), 0.0f);
-			m_bandScratch.assign(m_band.size(), 0.0f);
+			m_bandScratch.clear();
 			m_touched.clear();
 			m_bandTouched.clear();
 		}

@@ -262,6 +262,11 @@ BundleAdjustment::BundleAdjustment(
 		// the window to the rest of the map.
 		m->constant[i] = fixedSet.count(id) || id == map.keyframes().begin()->first;
 	auto& all = m->all;
+	// At most one entry per observation of the landmarks: reserved at once (a global
+	// adjustment holds hundreds of thousands, and a doubling vector up to twice that).
+	std::size_t observations = 0;
+	for (LandmarkId lm : m->lms) observations += map.landmark(lm).observations.size();
+	all.reserve(observations);
 	for (std::size_t lmRow = 0; lmRow < m->lms.size(); lmRow++)
 	{
 		const LandmarkId lm = m->lms[lmRow];

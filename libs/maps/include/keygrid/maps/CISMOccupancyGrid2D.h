@@ -369,8 +369,8 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	std::string m_optionSection;
 	uint64_t m_nextAutoKeyframeId{1ULL << 62};  ///< ids for insertObservation() inputs
 	double m_lastRebuildSeconds{0};
-	/** Per-insertion scratch: the one update each cell (heightBand: each slice) gets from the
-	 * current keyframe, and the indices touched. */
+	/** Per-insertion scratch: the one update each cell (heightBand: each slice of a cell in the
+	 * keyframe's BandWindow) gets from the current keyframe, and the indices touched. */
 	std::vector<float> m_scratch, m_bandScratch;
 	std::vector<int> m_touched;
 	std::vector<size_t> m_bandTouched;
@@ -388,6 +388,23 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	int bandSlicesWanted() const;
 	/** (Re)allocates m_band for the current grid size and options, cleared. */
 	void resetBand();
+	/** The cells [x0, x0 + w) x [y0, y0 + h) of the grid that one keyframe's rays can reach:
+	 * m_bandScratch holds their slices (window cell index * stride + slot). */
+	struct BandWindow
+	{
+		int x0{0}, y0{0}, w{0}, h{0};
+		size_t cells() const { return static_cast<size_t>(w) * static_cast<size_t>(h); }
+		bool contains(int cx, int cy) const { return cx >= x0 && cx < x0 + w && cy >= y0 && cy < y0 + h; }
+		size_t index(int cx, int cy) const { return static_cast<size_t>(cx - x0) + static_cast<size_t>(cy - y0) * static_cast<size_t>(w); }
+		size_t gridCell(size_t windowCell, size_t sizeX) const
+		{
+			const size_t ww = static_cast<size_t>(w);
+			return static_cast<size_t>(x0) + windowCell % ww + (static_cast<size_t>(y0) + windowCell / ww) * sizeX;
+		}
+	};
+	/** The window over the floor-frame box [x0,x1]x[y0,y1] (grown to contain it) with a margin
+	 * of two cells for the traversals' neighbours, clipped to the grid. */
+	BandWindow bandWindow(double x0, double x1, double y0, double y1) const;
 	/** The column log-odds of a cell from its band values: the strongest obstacle evidence in
 	 * the band if any is positive, else the ground clearance. */
 	float columnLogOdds(size_t cell) const;
