@@ -1,3 +1,5 @@
+#include "RansacSampling.h"
+
 #include <ceres/ceres.h>
 #include <keygrid/loop/Sim3Ransac.h>
 
@@ -152,21 +154,14 @@ Sim3RansacResult estimateSim3Ransac(const std::vector<Sim3Match>& ms, const core
 	{
 		++res.iterations;
 		std::size_t s[3];
-		s[0] = pick(rng);
-		do s[1] = pick(rng);
-		while (s[1] == s[0]);
-		do s[2] = pick(rng);
-		while (s[2] == s[0] || s[2] == s[1]);
+		detail::drawThreeDistinct(rng, pick, s);
 		Sim3 S;
 		if (!fitMinimal(ms, s, S)) continue;
 		const int count = classify(ms, S, K, opts.inlierChi2, inl);
 		if (count <= bestCount) continue;
 		bestCount = count;
 		best = S;
-		// Hypotheses needed so that P(no all-inlier sample) < 1 - confidence.
-		const double w = static_cast<double>(count) / static_cast<double>(n);
-		const double pGood = w * w * w;
-		needed = pGood >= 1.0 ? it + 1 : static_cast<int>(std::ceil(std::log(1 - opts.confidence) / std::log(1 - pGood)));
+		needed = detail::ransacIterationsNeeded(count, n, opts.confidence, it, needed);
 	}
 	if (bestCount < 3) return res;
 
