@@ -5,6 +5,9 @@
 // keyframes that see the same wall, its measured relative pose must agree with the ground truth
 // within a bound derived from the noise, and the correction must take the map most of the way
 // to the measurement. On a path that stops short of its start no loop may be claimed.
+// Monocular: the keyframes also drift in scale (each keyframe's part of the map is a similarity
+// of the truth) and carry no depth; the loop must be measured as a similarity and the
+// correction must take the scale drift out.
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/loop/LoopCloser.h>
 
@@ -35,6 +38,15 @@ constexpr double kMaxDepth = kWallRadius + kPathRadius;
 /** A landmark stays in the local map while one of the last kLocalMapKeyFrames keyframes
  * observes it; a point seen again after that gets a new landmark, as tracking would create one. */
 constexpr sfm::KeyFrameId kLocalMapKeyFrames = 5;
+/** Monocular: the scale of keyframe k's part of the map is e^(kScaleDriftPerKeyFrame k) map
+ * units per metre (23 % at the last keyframe of the loop path). */
+constexpr double kScaleDriftPerKeyFrame = 0.005;
+
+enum class Sensor
+{
+	Rgbd,
+	Monocular
+};
 
 test::SyntheticPoints makeWall(std::mt19937& rng) { return test::cylinderWall(rng, kWallRadius, kWallHalfHeight, kWallPoints); }
 
@@ -56,11 +68,24 @@ CPose3D drift(std::size_t k)
 	return CPose3D(0.002 * s, 0, 0.001 * s, 0, 0.0008 * s, 0);
 }
 
+/** Monocular drift of keyframe k: drift(k) with the scale e^(kScaleDriftPerKeyFrame k). */
+loop::Sim3 similarityDrift(std::size_t k)
+{
+	return loop::Sim3::fromIsometry(loop::toIsometry(drift(k)), std::exp(kScaleDriftPerKeyFrame * static_cast<double>(k)));
+}
+
+/** Keyframe k as the drifted map holds it: the map maps its camera coordinates (metres) to the
+ * world by similarityDrift(k) * groundTruthPose(k); its pose is that similarity's rigid part. */
+loop::Sim3 driftedSim3(std::size_t k) { return similarityDrift(k) * loop::Sim3::fromIsometry(loop::toIsometry(groundTruthPose(k))); }
+
 /** The keyframes of one path put through the loop closer, as local mapping would leave them. */
 class LoopRun
 {
    public:
-	explicit LoopRun(unsigned seed) : m_rng(seed), m_wall(makeWall(m_rng)), m_mapper(m_map, {}, {}), m_loop(m_map, m_mapper, options(), {}) {}
+	explicit LoopRun(unsigned seed, Sensor sensor = Sensor::Rgbd)
+		: m_sensor(sensor), m_rng(seed), m_wall(makeWall(m_rng)), m_mapper(m_map, {}, {}), m_loop(m_map, m_mapper, options(sensor), {})
+	{
+	}
 
 	/** Adds keyframe k (drifted pose, measurements from the ground truth), then loop closing.
 	 * Keyframes are added in path order, so keyframe ids are the path's keyframe numbers. */
@@ -69,11 +94,13 @@ class LoopRun
 		sfm::KeyFrame kf;
 		kf.frameIndex = 10 * k;
 		kf.timestamp = 1.0 + static_cast<double>(k) / 3.0;
-		kf.T_world_cam = drift(k) + groundTruthPose(k);
+		kf.T_world_cam = m_sensor == Sensor::Rgbd ? drift(k) + groundTruthPose(k) : loop::toCPose3D(driftedSim3(k).rigid());
 		std::vector<int> pointOf;
 		kf.features = test::observePoints(m_wall, groundTruthPose(k), m_cam, m_noise, m_rng, &pointOf);
 		const sfm::KeyFrameId id = m_map.addKeyFrame(std::move(kf)).id;
 		associate(id, pointOf);
+		// Without depth the keyframe has its landmarks only.
+		if (m_sensor == Sensor::Monocular) std::fill(m_map.keyframe(id).features.depth.begin(), m_map.keyframe(id).features.depth.end(), 0.f);
 		m_pointsOf[id] = std::move(pointOf);
 		std::map<sfm::KeyFrameId, CPose3D> before;
 		for (const auto& [kfId, keyframe] : m_map.keyframes()) before[kfId] = keyframe.T_world_cam;
@@ -116,10 +143,11 @@ class LoopRun
 	}
 
    private:
-	static loop::LoopClosingOptions options()
+	static loop::LoopClosingOptions options(Sensor sensor)
 	{
 		loop::LoopClosingOptions o;
 		o.vocabulary = "train";  // on the first keyframes: no file needed
+		o.monocular = sensor == Sensor::Monocular;
 		return o;
 	}
 
@@ -133,7 +161,8 @@ class LoopRun
 		for (std::size_t kp = 0; kp < pointOf.size(); kp++)
 		{
 			auto it = m_landmarkOfPoint.find(pointOf[kp]);
-			if (it != m_landmarkOfPoint.end() && it->second.second + kLocalMapKeyFrames >= id)
+			// (A loop correction may have fused the landmark into another: then a new one.)
+			if (it != m_landmarkOfPoint.end() && it->second.second + kLocalMapKeyFrames >= id && m_map.hasLandmark(it->second.first))
 			{
 				m_map.addObservation(it->second.first, id, static_cast<int>(kp));
 				it->second.second = id;
@@ -143,12 +172,14 @@ class LoopRun
 			const Eigen::Vector3d p_cam = K.backProject(kf.features.undistorted[kp].x, kf.features.undistorted[kp].y, kf.features.depth[kp]);
 			Eigen::Vector3d p_world;
 			kf.T_world_cam.composePoint(p_cam.x(), p_cam.y(), p_cam.z(), p_world.x(), p_world.y(), p_world.z());
+			if (m_sensor == Sensor::Monocular) p_world = driftedSim3(id) * p_cam;  // in the keyframe's drifted scale
 			m_landmarkOfPoint[pointOf[kp]] = {m_map.addLandmark(p_world, id, static_cast<int>(kp)), id};
 		}
 		for (auto l : observed) m_map.updateLandmarkStats(l);
 		m_map.updateCovisibility(id);
 	}
 
+	Sensor m_sensor;
 	std::mt19937 m_rng;
 	const core::RgbdCamera m_cam;
 	const test::MeasurementNoise m_noise{0.5, 0.01};
@@ -227,4 +258,50 @@ TEST(LoopCloser, ClaimsNoLoopOnAPathWithoutRevisit)
 	// The keyframe that completes the training set trains the vocabulary and is not queried.
 	EXPECT_EQ(queried, kKeyFramesWithoutLoop - loop::LoopClosingOptions().trainKeyFrames);
 	EXPECT_FALSE(run.loopCloser().lastPoseGraph().has_value());
+}
+
+TEST(LoopCloser, MonocularLoopMeasuresTheScaleDriftAndCorrectsIt)
+{
+	LoopRun run(1, Sensor::Monocular);
+	for (std::size_t k = 0; k < kKeyFramesWithLoop; k++) run.addKeyFrame(k);
+	ASSERT_FALSE(run.closures().empty());
+	for (const auto& q : run.loopCloser().queries())
+		EXPECT_TRUE(q.outcome != loop::LoopQueryOutcome::Closed || q.projectedMatches >= loop::LoopClosingOptions().sim3MinMatches);
+	const auto& c = run.closures().front();
+	const auto& ev = c.event;
+	SCOPED_TRACE("loop " + std::to_string(ev.keyframe) + " -> " + std::to_string(ev.loopKeyFrame));
+	EXPECT_GE(ev.keyframe, ev.loopKeyFrame + static_cast<sfm::KeyFrameId>(loop::LoopClosingOptions().minKeyFrameGap));
+	const double sCur = similarityDrift(ev.keyframe).s, sLoop = similarityDrift(ev.loopKeyFrame).s;
+
+	// The measurement: the pose of the current camera in the loop keyframe's frame and units,
+	// T_loop_cur_true with its translation in the loop keyframe's scale. The landmarks a
+	// keyframe observes were placed by it or by one of the kLocalMapKeyFrames before it, so
+	// each side's scale is uncertain by up to 5 x 0.5 % = 2.5 %; the rotation is fixed by the
+	// pixels (0.5 px noise): well under a degree.
+	const CPose3D T_loop_cur_true = groundTruthPose(ev.keyframe) - groundTruthPose(ev.loopKeyFrame);
+	const CPose3D T_loop_cur_meas = ev.T_loop_cur;
+	const Eigen::Vector3d t_true = sLoop * Eigen::Vector3d(T_loop_cur_true.x(), T_loop_cur_true.y(), T_loop_cur_true.z());
+	const Eigen::Vector3d t_meas(T_loop_cur_meas.x(), T_loop_cur_meas.y(), T_loop_cur_meas.z());
+	EXPECT_LT((t_meas - t_true).norm(), 0.05 * t_true.norm() + 0.01) << t_meas.transpose() << " vs " << t_true.transpose();
+	EXPECT_LT(test::rotationAngleDeg(T_loop_cur_meas - T_loop_cur_true), 1.0);
+
+	// The correction: before it the current keyframe's part of the map was sCur / sLoop times
+	// the loop keyframe's (1.16). The Sim(3) pose graph (unit weights) shares that out between
+	// the loop edge and the chain joining the two keyframes, whose covisibility edges (each
+	// keyframe to the next kLocalMapKeyFrames) make it about as stiff as the one loop edge, as
+	// in the rigid test above: at least half of the scale drift goes. A rigid correction would
+	// leave scaleCorrection = 1 and fail this.
+	const double driftBefore = std::log(sCur / sLoop);
+	ASSERT_GT(driftBefore, 0.1);
+	const double driftAfter = std::log(sCur * ev.scaleCorrection / sLoop);
+	EXPECT_LT(std::abs(driftAfter), 0.5 * driftBefore) << "scale correction " << ev.scaleCorrection;
+	// ... and the current keyframe lands closer to its true place relative to the first
+	// keyframe, which the correction holds fixed, scale included (its units are the map's).
+	const CPose3D truth = groundTruthPose(ev.keyframe) - groundTruthPose(0);
+	const CPose3D errorBefore = c.T_first_cur_before - truth, errorAfter = c.T_first_cur_after - truth;
+	EXPECT_LT(errorAfter.translation().norm(), 0.5 * errorBefore.translation().norm()) << "before " << errorBefore << ", after " << errorAfter;
+	EXPECT_LT(test::rotationAngleDeg(errorAfter), test::rotationAngleDeg(errorBefore)) << "before " << errorBefore << ", after " << errorAfter;
+	// The first keyframe holds the map's units: not moved.
+	ASSERT_EQ(ev.newPoses.count(0), 1u);
+	EXPECT_LT((ev.newPoses.at(0) - loop::toCPose3D(driftedSim3(0).rigid())).translation().norm(), 1e-9);
 }

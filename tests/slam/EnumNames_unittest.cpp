@@ -35,6 +35,7 @@ TEST(EnumNames, LoopQueryOutcomesAreTheWordsOfLoopQueriesCsv)
 	EXPECT_STREQ(loop::toString(LoopQueryOutcome::NotConsistent), "not_consistent");
 	EXPECT_STREQ(loop::toString(LoopQueryOutcome::FewMatches), "few_matches");
 	EXPECT_STREQ(loop::toString(LoopQueryOutcome::RansacFailed), "ransac_failed");
+	EXPECT_STREQ(loop::toString(LoopQueryOutcome::ProjectionFailed), "projection_failed");
 	EXPECT_STREQ(loop::toString(LoopQueryOutcome::Implausible), "implausible");
 	EXPECT_STREQ(loop::toString(LoopQueryOutcome::MergePending), "merge_pending");
 	EXPECT_STREQ(loop::toString(LoopQueryOutcome::MergeSeenThrough), "merge_seen_through");

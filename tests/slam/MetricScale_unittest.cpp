@@ -120,6 +120,27 @@ TEST(MetricScale, RescalesTheMapToTheCameraHeightAndReestimatesEveryNKeyFrames)
 	EXPECT_NEAR(scale.stats().totalFactor, kCameraHeight / kHeightMap, 1e-5);
 }
 
+// After a Sim(3) loop correction (which keeps the first keyframe's units but rescales parts of
+// the map) the scale is measured again at the next update, not reestimate_every keyframes later.
+TEST(MetricScale, EstimatesAgainRightAfterARequest)
+{
+	sfm::SparseMap map;
+	slam::MetricScale scale(options());
+	addRoom(map, map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2500)).id);
+	for (int k = 1; k < 12; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
+	ASSERT_TRUE(scale.update(map).has_value()) << scale.stats().lastMessage;
+	// The map grows by 10 % (as a correction could leave it): not due yet, unless requested.
+	map.rescale(1.1);
+	EXPECT_FALSE(scale.update(map).has_value());
+	scale.requestEstimate();
+	const auto s = scale.update(map);
+	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+	EXPECT_NEAR(*s, 1.0 / 1.1, 1e-6);
+	for (const auto& [id, kf] : map.keyframes()) EXPECT_NEAR(kf.T_world_cam.z(), kCameraHeight, 1e-5);
+	// The request is used up: the next estimate waits for reestimate_every keyframes again.
+	EXPECT_FALSE(scale.update(map).has_value());
+}
+
 TEST(MetricScale, IsRetriedAtEveryKeyFrameUntilTheFloorIsFound)
 {
 	sfm::SparseMap map;

@@ -1,3 +1,5 @@
+#include "LoopCorrection.h"
+
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/loop/DataFiles.h>
 #include <keygrid/loop/LoopCloser.h>
@@ -26,9 +28,7 @@ constexpr std::size_t kCandidateGroupNeighbours = 10;
 /** Ratio test of the verification matches: the best descriptor distance must be clearly
  * smaller than the second best, as repeated texture gives ambiguous matches. */
 constexpr float kVerificationMatchRatio = 0.8f;
-/** Each side of a loop (seen-through test, landmark fusion): the keyframe and this many of its
- * best covisibles. */
-constexpr std::size_t kLoopSideNeighbours = 5;
+using detail::kLoopSideNeighbours;
 /** Keyframes after a closed loop without detection: the map around it is still being joined. */
 constexpr sfm::KeyFrameId kKeyFramesPausedAfterLoop = 5;
 }  // namespace
@@ -77,6 +77,8 @@ const char* toString(LoopQueryOutcome o)
 			return "few_matches";
 		case LoopQueryOutcome::RansacFailed:
 			return "ransac_failed";
+		case LoopQueryOutcome::ProjectionFailed:
+			return "projection_failed";
 		case LoopQueryOutcome::Implausible:
 			return "implausible";
 		case LoopQueryOutcome::MergePending:
@@ -134,6 +136,8 @@ core::OptionFields LoopClosingOptions::fields()
 	f.add("merge_tolerance_m", mergeToleranceMetres, "[m] how far their alignments may differ", R::positive());
 	f.add("merge_tolerance_deg", mergeToleranceDeg, "[deg] ... and in rotation", R::positive());
 	f.add("merge_max_seen_through", mergeMaxSeenThrough, "largest share of landmarks seen through for a merge", R::inRange(0, 1));
+	f.add("sim3_min_inliers", sim3.minInliers, "monocular: similarity RANSAC inliers (by reprojection) to accept a loop", R::atLeast(3));
+	f.add("sim3_min_matches", sim3MinMatches, "monocular: loop landmarks the similarity must project onto keypoints", R::atLeast(3));
 	return f;
 }
 
@@ -144,6 +148,7 @@ void LoopClosingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 	// The vocabulary's size and the verification's other parameters.
 	ransac.validate(s);
 	vocabularyOptions.validate(s);
+	sim3.validate();
 }
 
 void LoopClosingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
@@ -377,64 +382,11 @@ KeyFramePoses keyFramePoses(const sfm::SparseMap& map)
 	for (const auto& [id, kf] : map.keyframes()) poses[id] = toIsometry(kf.T_world_cam);
 	return poses;
 }
-
-/** The pose graph of a loop correction (see LoopCloser::correct): a vertex per keyframe, the
- * keyframes of the current map moved first by `align`; odometry edges between consecutive
- * keyframes of one map and covisibility edges between strongly covisible ones, all keeping
- * their current relative poses; the loop edge with its measurement; the gauge fixed. */
-PoseGraph loopCorrectionGraph(
-	const sfm::SparseMap& map, const KeyFramePoses& oldIso, sfm::KeyFrameId cur, sfm::KeyFrameId cand,
-	const Eigen::Isometry3d& T_cand_cur, const Eigen::Isometry3d& align, int covisibilityEdgeMinWeight)
-{
-	const std::uint32_t curMap = map.keyframe(cur).mapId;
-	const bool merge = curMap != map.keyframe(cand).mapId;
-	PoseGraph g;
-	for (const auto& [id, kf] : map.keyframes()) g.addVertex(id, kf.mapId == curMap ? align * oldIso.at(id) : oldIso.at(id));
-	auto rel = [&](sfm::KeyFrameId a, sfm::KeyFrameId b) { return g.pose(a).inverse() * g.pose(b); };
-	std::map<std::uint32_t, sfm::KeyFrameId> prevOfMap;
-	for (const auto& [id, kf] : map.keyframes())
-	{
-		const auto p = prevOfMap.find(kf.mapId);
-		const bool hasPrev = p != prevOfMap.end();
-		const sfm::KeyFrameId prev = hasPrev ? p->second : 0;
-		if (hasPrev) g.addEdge({prev, id, rel(prev, id), Matrix6d::Identity(), EdgeKind::Odometry});
-		for (const auto& [other, w] : kf.covisibility)
-			if (other < id && w >= covisibilityEdgeMinWeight && (!hasPrev || other != prev))
-				g.addEdge({other, id, rel(other, id), Matrix6d::Identity(), EdgeKind::Covisibility});
-		prevOfMap[kf.mapId] = id;
-	}
-	g.addEdge({cand, cur, T_cand_cur, Matrix6d::Identity(), EdgeKind::Loop});
-	// Gauge: the first keyframe defines the world frame; the loop only bends the rest onto
-	// it. A loop inside a map not merged yet keeps that map's first keyframe in place.
-	g.setFixed(map.keyframes().begin()->first);
-	if (!merge && map.keyframes().begin()->second.mapId != curMap)
-		for (const auto& [id, kf] : map.keyframes())
-			if (kf.mapId == curMap)
-			{
-				g.setFixed(id);
-				break;
-			}
-	return g;
-}
-
-/** Landmarks follow the keyframe that created them (or their first observer) from its pose in
- * oldIso to its pose in newIso; landmarks of keyframes not corrected stay. */
-void moveLandmarksWithKeyFrames(sfm::SparseMap& map, const KeyFramePoses& oldIso, const KeyFramePoses& newIso)
-{
-	std::vector<std::pair<sfm::LandmarkId, Eigen::Vector3d>> moved;
-	for (const auto& [id, lm] : map.landmarks())
-	{
-		sfm::KeyFrameId ref = lm.firstKeyFrame;
-		if (!newIso.count(ref)) ref = lm.observations.begin()->first;
-		if (!newIso.count(ref)) continue;
-		moved.emplace_back(id, movePointWithKeyFrame(lm.p_world, oldIso.at(ref), newIso.at(ref)));
-	}
-	for (const auto& [id, p] : moved) map.landmark(id).p_world = p;
-}
+}  // namespace
 
 /** Joins both sides of a closed loop: the landmarks of the loop keyframe's neighbourhood are
  * fused into the current keyframe's neighbourhood, whose covisibility is then updated. */
-void joinLoopSides(sfm::SparseMap& map, sfm::LocalMapper& mapper, sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K)
+void detail::joinLoopSides(sfm::SparseMap& map, sfm::LocalMapper& mapper, sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K)
 {
 	std::set<sfm::LandmarkId> loopSide;
 	std::vector<sfm::KeyFrameId> loopGroup = {cand}, curGroup = {cur};
@@ -449,7 +401,6 @@ void joinLoopSides(sfm::SparseMap& map, sfm::LocalMapper& mapper, sfm::KeyFrameI
 	for (auto id : curGroup)
 		if (map.hasKeyFrame(id)) map.updateCovisibility(id);
 }
-}  // namespace
 
 LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K)
 {
@@ -465,7 +416,7 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 	const Eigen::Isometry3d align = merge ? toIsometry(m_map.keyframe(cand).T_world_cam) * T_cand_cur * toIsometry(m_map.keyframe(cur).T_world_cam).inverse()
 										  : Eigen::Isometry3d::Identity();
 	KeyFramePoses oldIso = keyFramePoses(m_map), newIso;
-	PoseGraph g = loopCorrectionGraph(m_map, oldIso, cur, cand, T_cand_cur, align, m_opts.covisibilityEdgeMinWeight);
+	PoseGraph g = detail::loopCorrectionGraph<PoseGraph>(m_map, oldIso, cur, cand, T_cand_cur, align, m_opts.covisibilityEdgeMinWeight);
 	const auto summary = g.optimize(m_opts.poseGraph);
 
 	LoopClosureEvent ev;
@@ -481,23 +432,23 @@ LoopClosureEvent LoopCloser::correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, 
 		m_map.keyframe(c.id).T_world_cam = toCPose3D(c.T_world_kf_new);
 		ev.newPoses[c.id] = m_map.keyframe(c.id).T_world_cam;
 	}
-	moveLandmarksWithKeyFrames(m_map, oldIso, newIso);
+	detail::moveLandmarksWithKeyFrames(m_map, oldIso, newIso);
 	ev.correctionMetres = (newIso[cur].translation() - oldIso[cur].translation()).norm();
-	joinLoopSides(m_map, m_mapper, cur, cand, K);
+	detail::joinLoopSides(m_map, m_mapper, cur, cand, K);
 	m_lastGraph = g;
 	return ev;
 }
 
 std::optional<LoopClosureEvent> LoopCloser::closeVerifiedLoop(
 	sfm::KeyFrameId kf, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, std::size_t frameIndex, double score,
-	const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec)
+	const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec, const std::optional<Sim3>& S_cand_cur)
 {
 	if (!plausible(kf, cand, T_cand_cur))
 	{
 		rec.outcome = LoopQueryOutcome::Implausible;
 		return std::nullopt;
 	}
-	auto ev = correct(kf, cand, T_cand_cur, K);
+	auto ev = S_cand_cur ? correctSim3(kf, cand, *S_cand_cur, K) : correct(kf, cand, T_cand_cur, K);
 	if (ev.newPoses.empty())
 	{
 		rec.outcome = LoopQueryOutcome::PoseGraphFailed;
@@ -552,7 +503,15 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 	{
 		rec.verifiedCandidate = *cand;
 		Eigen::Isometry3d T_cand_cur = Eigen::Isometry3d::Identity();
-		if (verify(kf, *cand, K, T_cand_cur, rec) && mergeConfirmed(kf, *cand, T_cand_cur, K, rec))  // else they named the outcome
+		Sim3 S_cand_cur;
+		if (m_opts.monocular)
+		{
+			// The rigid part of the similarity places the current camera in the loop
+			// keyframe's frame and units, as T_cand_cur does with depth.
+			if (verifySim3(kf, *cand, K, S_cand_cur, rec) && mergeConfirmed(kf, *cand, S_cand_cur.rigid(), K, rec))
+				out = closeVerifiedLoop(kf, *cand, S_cand_cur.rigid(), frameIndex, score, K, rec, S_cand_cur);
+		}
+		else if (verify(kf, *cand, K, T_cand_cur, rec) && mergeConfirmed(kf, *cand, T_cand_cur, K, rec))  // else they named the outcome
 			out = closeVerifiedLoop(kf, *cand, T_cand_cur, frameIndex, score, K, rec);
 		if (out) out->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}

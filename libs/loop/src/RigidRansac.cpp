@@ -1,3 +1,5 @@
+#include "RansacSampling.h"
+
 #include <keygrid/loop/RigidRansac.h>
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -111,11 +113,7 @@ RigidRansacResult estimateRigidTransformRansac(
 	{
 		++res.iterations;
 		std::size_t s[3];
-		s[0] = pick(rng);
-		do s[1] = pick(rng);
-		while (s[1] == s[0]);
-		do s[2] = pick(rng);
-		while (s[2] == s[0] || s[2] == s[1]);
+		detail::drawThreeDistinct(rng, pick, s);
 		// Degenerate samples (collinear or coincident points) do not fix a rotation.
 		const double areaB = (p_b[s[1]] - p_b[s[0]]).cross(p_b[s[2]] - p_b[s[0]]).norm();
 		const double areaA = (p_a[s[1]] - p_a[s[0]]).cross(p_a[s[2]] - p_a[s[0]]).norm();
@@ -130,12 +128,7 @@ RigidRansacResult estimateRigidTransformRansac(
 			bestCount = count;
 			bestSse = sse;
 			best = T;
-			// Hypotheses needed so that P(no all-inlier sample) < 1 - confidence.
-			const double w = static_cast<double>(count) / static_cast<double>(n);
-			const double pGood = w * w * w;
-			if (pGood >= 1.0) needed = it + 1;
-			else if (pGood > 0)
-				needed = static_cast<int>(std::ceil(std::log(1 - opts.confidence) / std::log(1 - pGood)));
+			needed = detail::ransacIterationsNeeded(count, n, opts.confidence, it, needed);
 		}
 	}
 	if (bestCount < 3) return res;

@@ -92,6 +92,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 	mapping.ba.bf = tracker.pose.bf;
 	mapping.ba.disparitySigma = tracker.pose.disparitySigma;
 	tracker.monocular = sensor == Sensor::Monocular;
+	loop.monocular = sensor == Sensor::Monocular;
 	// The two-view map is bundle-adjusted as local mapping adjusts its windows.
 	tracker.mono.ba = mapping.ba;
 }

@@ -397,6 +397,10 @@ std::optional<loop::LoopClosureEvent> System::closeLoops(const KeyFrameJob& job,
 	auto ev = m_loopCloser->process(job.keyframe, job.frameIndex, job.K);
 	m_timings.add("loop_closing", secondsSince(t0));
 	if (!ev) return std::nullopt;
+	// A Sim(3) correction rescales the map around the loop: the camera-height scale is
+	// measured again on the corrected map at the next keyframe (the correction itself keeps
+	// the units of the first keyframe, so the two do not pull the scale against each other).
+	if (m_metricScale) m_metricScale->requestEstimate();
 	PoseCorrection c{PoseCorrection::Source::LoopClosure, ev->newPoses, job.keyframe};
 	for (const auto& [name, sec] : publishCorrection(c, tf)) m_timings.add(name, sec);
 	return ev;

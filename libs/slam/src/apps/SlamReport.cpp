@@ -35,6 +35,7 @@ Json loopClosures(const System& sys)
 {
 	Json loops = Json::array();
 	for (const auto& ev : sys.loopClosures())
+	{
 		loops.push_back({{"frame", ev.frameIndex},
 						 {"keyframe", ev.keyframe},
 						 {"loop_keyframe", ev.loopKeyFrame},
@@ -46,6 +47,9 @@ Json loopClosures(const System& sys)
 						 {"measured_angle_deg", rounded(ev.measuredAngleDeg, 3)},
 						 {"correction_m", rounded(ev.correctionMetres, 4)},
 						 {"seconds", rounded(ev.seconds, 4)}});
+		// A monocular loop is a similarity: the scale it gave the current keyframe's part of the map.
+		if (sys.config().sensor == Sensor::Monocular) loops.back()["scale_correction"] = rounded(ev.scaleCorrection, 4);
+	}
 	return loops;
 }
 

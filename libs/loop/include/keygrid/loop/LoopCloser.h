@@ -6,12 +6,19 @@
  * verified geometrically with depth (3D-3D RANSAC). A verified loop adds an edge to the SE(3)
  * keyframe pose graph; after optimisation landmarks follow their keyframes and the duplicated
  * landmarks around the loop are fused.
+ *
+ * Monocular maps (LoopClosingOptions::monocular; LoopCloser_monocular.cpp) have no depth and an
+ * arbitrary, drifting scale: the loop is a similarity estimated from the matched map points of
+ * both keyframes (Sim3Ransac.h) and verified by projecting the loop side's landmarks into the
+ * current keyframe, and the correction is a Sim(3) pose graph (Sim3PoseGraph.h) whose scale
+ * correction the landmarks follow.
  */
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/loop/ConsistencyChecker.h>
 #include <keygrid/loop/KeyFrameDatabase.h>
 #include <keygrid/loop/PoseGraph.h>
 #include <keygrid/loop/RigidRansac.h>
+#include <keygrid/loop/Sim3Ransac.h>
 #include <keygrid/loop/Vocabulary.h>
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/SparseMap.h>
@@ -60,6 +67,16 @@ struct LoopClosingOptions
 	/** Covisibility edges of the pose graph need this many shared landmarks (Default: 100) */
 	int covisibilityEdgeMinWeight{100};
 	PoseGraphOptions poseGraph;
+	/** A map without depth (monocular): loops are similarities verified by reprojection and
+	 * corrected by a Sim(3) pose graph. Set by the application from [slam] sensor, not a
+	 * [loop_closing] key (Default: false) */
+	bool monocular{false};
+	/** Monocular verification: RANSAC of the similarity between the matched map points of both
+	 * keyframes, inliers by reprojection (Default: Sim3RansacOptions', sim3_min_inliers = 20) */
+	Sim3RansacOptions sim3;
+	/** Monocular verification: landmarks of the loop keyframe and its covisibles that, mapped
+	 * into the current keyframe with the similarity, must match its keypoints (Default: 40) */
+	int sim3MinMatches{40};
 
 	/** The INI keys, with description and rule. */
 	core::OptionFields fields();
@@ -88,6 +105,9 @@ struct LoopClosureEvent
 	double score{0};
 	int inliers{0};
 	double correctionMetres{0};  //!< how far the current keyframe moved
+	/** Monocular: the scale the correction gave the current keyframe's neighbourhood (s_new /
+	 * s_old, > 1: it grew); 1 for a rigid correction */
+	double scaleCorrection{1};
 	/** The loop joined two maps (KeyFrame::mapId): the current keyframe's map was moved into
 	 * the loop keyframe's and now has its id. */
 	bool mergedMap{false};
@@ -105,13 +125,14 @@ enum class LoopQueryOutcome
 	NotConsistent,  //!< no candidate group seen in enough consecutive keyframes
 	FewMatches,  //!< geometric verification: too few matches with depth
 	RansacFailed,  //!< geometric verification: too few RANSAC inliers
+	ProjectionFailed,  //!< monocular verification: the similarity maps too few loop landmarks onto keypoints
 	Implausible,  //!< correction larger than drift explains
 	MergePending,  //!< a loop between two maps waiting for more that agree (mergeConsistency)
 	MergeSeenThrough,  //!< a loop between two maps that puts landmarks where a keyframe sees free space
 	PoseGraphFailed
 };
 /** "closed", "no_vocabulary", "after_loop", "no_candidate", "not_consistent", "few_matches",
- * "ransac_failed", "implausible", "merge_pending", "merge_seen_through" or "pose_graph_failed"
+ * "ransac_failed", "projection_failed", "implausible", "merge_pending", "merge_seen_through" or "pose_graph_failed"
  * (loop_queries.csv "outcome"). */
 const char* toString(LoopQueryOutcome o);
 
@@ -129,8 +150,11 @@ struct LoopQueryRecord
 	double bestScore{0};
 	/** The candidate that passed the consistency check and went to verification */
 	std::optional<sfm::KeyFrameId> verifiedCandidate;
-	/** Verification: descriptor matches with depth on both sides, RANSAC inliers */
+	/** Verification: descriptor matches with depth on both sides (monocular: with a landmark on
+	 * both sides), RANSAC inliers */
 	int matches{0}, inliers{0};
+	/** Monocular verification: loop landmarks the similarity projects onto current keypoints */
+	int projectedMatches{0};
 	double querySeconds{0};  //!< BoW transform + database query [s]
 	/** A loop between two maps: the share of landmarks seen through (SeenThroughCheck.h) */
 	double seenThroughRatio{0};
@@ -187,11 +211,20 @@ class LoopCloser
 	/** False when the loop measurement disagrees with the estimate more than drift can explain. */
 	bool plausible(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur) const;
 	bool verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, LoopQueryRecord& rec);
-	/** Plausibility check, pose-graph correction and the event; rec.outcome says which. */
+	/** Plausibility check, pose-graph correction (the Sim(3) one when S_cand_cur is given, its
+	 * rigid part being T_cand_cur) and the event; rec.outcome says which. */
 	std::optional<LoopClosureEvent> closeVerifiedLoop(
 		sfm::KeyFrameId kf, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, std::size_t frameIndex,
-		double score, const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec);
+		double score, const sfm::PinholeIntrinsics& K, LoopQueryRecord& rec, const std::optional<Sim3>& S_cand_cur = std::nullopt);
 	LoopClosureEvent correct(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Eigen::Isometry3d& T_cand_cur, const sfm::PinholeIntrinsics& K);
+	/** Monocular verification (LoopCloser_monocular.cpp): the similarity S_cand_cur from the
+	 * keyframes' matched map points, checked by projection; false with rec.outcome set. */
+	bool verifySim3(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Sim3& S_cand_cur, LoopQueryRecord& rec);
+	/** Loop-side landmarks that S_cand_cur maps onto keypoints of the current keyframe. */
+	int countProjectedMatches(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Sim3& S_cand_cur, const sfm::PinholeIntrinsics& K) const;
+	/** The Sim(3) counterpart of correct(): keyframes take the rigid part of their corrected
+	 * similarity, landmarks follow their keyframe's similarity (scale included). */
+	LoopClosureEvent correctSim3(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const Sim3& S_cand_cur, const sfm::PinholeIntrinsics& K);
 
 	sfm::SparseMap& m_map;
 	sfm::LocalMapper& m_mapper;

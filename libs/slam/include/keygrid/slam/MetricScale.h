@@ -50,6 +50,10 @@ class MetricScale
 	 * (SparseMap::rescale) and returns the factor; nullopt when nothing was applied. The
 	 * caller holds the map's lock. */
 	std::optional<double> update(sfm::SparseMap& map);
+	/** The map's scale changed in places (a Sim(3) loop correction, which keeps the units of the
+	 * map's first keyframe): the next update() estimates, whenever the last estimate was. The
+	 * caller holds the map's lock. */
+	void requestEstimate() { m_lastEstimateAt.reset(); }
 
 	struct Stats
 	{
