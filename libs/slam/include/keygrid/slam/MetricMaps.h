@@ -114,7 +114,8 @@ class MetricMaps
 		const sfm::SparseMap& map, double s, const Eigen::Vector3d& n_floor, double d_floor);
 
 	/** Inserts keyframe `kf` (pose as now in the map) into every map and its depth samples
-	 * (its map points when it has no depth) into the floor estimate. `travelled` is the
+	 * (its map points when it has no depth) into the floor estimate (none with
+	 * useFloorFromCameraHeight). `travelled` is the
 	 * camera's path length so far [m]. */
 	void insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId kf, double travelled);
 
