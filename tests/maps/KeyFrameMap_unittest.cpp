@@ -232,3 +232,41 @@ TEST(KeyFrameMap, OutputsAreTriedOneByOne)
 	}
 	std::filesystem::remove_all(dir);
 }
+
+/* A monocular map given metric scale: a correction with scale 2 names no pose, and the grid
+ * scales what it stored, the keyframe stored before the floor frame was known included. The
+ * camera at (0.0375, 0.0375, 0.5) with its map point 1 m ahead becomes a camera at (0.075,
+ * 0.075, 1) with its point 2 m ahead, on a row of cell centres: the point's cell (x = 2.075) is
+ * occupied, the cell of the unscaled point (x = 1.0375) is on the free part of the new ray, and
+ * nothing short of the band is occupied. The 3D grid, built from depth, refuses a scale. */
+TEST(KeyFrameMap, AScaleCorrectionScalesTheStoredRaysAndTheirPoses)
+{
+	CISMOccupancyGrid2D grid = paperGrid();
+	maps::KeyFrameMap& map = grid;
+	map.setFloorFrame(std::nullopt);  // the run's floor frame is not known yet
+	maps::MapKeyFrame kf;
+	kf.id = 3;
+	kf.T_world_cam = levelCameraAt(0.0375, 0.0375);
+	kf.points_world = {TPoint3D(1.0375, 0.0375, 0.5)};
+	map.insertKeyFrame(kf, maps::KeyFrameFeed{});
+	EXPECT_EQ(grid.countStates()[2], 0u);  // stored only
+
+	maps::MapCorrection correction;
+	correction.scale = 2.0;
+	correction.T_world_floor = CPose3D();
+	EXPECT_TRUE(map.applyCorrection(correction));
+	EXPECT_NEAR(grid.keyframes().at(3).T_world_cam.z(), 1.0, 1e-12);
+	EXPECT_EQ(grid.stateAt(2.075, 0.075), CellState::Occupied);
+	EXPECT_EQ(grid.stateAt(1.0375, 0.075), CellState::Free);
+	for (double x = 0.1; x < 1.9; x += 0.05) EXPECT_NE(grid.stateAt(x, 0.075), CellState::Occupied) << "x = " << x;
+
+	correction.scale = 0.0;
+	EXPECT_THROW(map.applyCorrection(correction), std::invalid_argument);
+
+	keygrid::CSubmappedOccupancyGrid3D grid3d;
+	maps::KeyFrameMap& map3d = grid3d;
+	correction.scale = 2.0;
+	EXPECT_FALSE(map3d.applyCorrection(correction));  // nothing to rescale
+	map3d.insertKeyFrame(wallKeyFrame(1, levelCameraAt(0.0), 2.0f), maps::KeyFrameFeed{});
+	EXPECT_THROW(map3d.applyCorrection(correction), std::invalid_argument);
+}

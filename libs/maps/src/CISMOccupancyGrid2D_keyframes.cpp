@@ -6,6 +6,7 @@
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
@@ -33,6 +34,19 @@ void CISMOccupancyGrid2D::insertKeyFrame(const maps::MapKeyFrame& kf, const maps
 
 bool CISMOccupancyGrid2D::applyCorrection(const maps::MapCorrection& correction)
 {
+	if (!(correction.scale > 0) || !std::isfinite(correction.scale))
+		throw std::invalid_argument("CISMOccupancyGrid2D::applyCorrection: scale " + std::to_string(correction.scale) + " is not a positive finite factor");
+	// A rescaled world: the stored rays (camera frame) and every pose's translation scale
+	// with it, also those of keyframes stored before the floor frame was known.
+	if (correction.scale != 1.0)
+		for (auto& [id, kf] : m_keyframes)
+		{
+			const float s = static_cast<float>(correction.scale);
+			for (auto& p : kf.points_cam) p = mrpt::math::TPoint3Df(p.x * s, p.y * s, p.z * s);
+			kf.T_world_cam.x(kf.T_world_cam.x() * correction.scale);
+			kf.T_world_cam.y(kf.T_world_cam.y() * correction.scale);
+			kf.T_world_cam.z(kf.T_world_cam.z() * correction.scale);
+		}
 	if (correction.T_world_floor) setExternalFloorPose(*correction.T_world_floor);
 	if (!floorKnown()) return false;  // nothing integrated yet: no floor frame
 	std::map<uint64_t, mrpt::poses::CPose3D> newPoses;

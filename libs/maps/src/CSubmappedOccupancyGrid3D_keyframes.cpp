@@ -6,6 +6,8 @@
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 
 #include <sstream>
+#include <stdexcept>
+#include <string>
 
 namespace keygrid
 {
@@ -16,6 +18,14 @@ void CSubmappedOccupancyGrid3D::insertKeyFrame(const maps::MapKeyFrame& kf, cons
 
 bool CSubmappedOccupancyGrid3D::applyCorrection(const maps::MapCorrection& correction)
 {
+	// Submaps are morphed rigidly; a rescaled world (monocular map given metric scale) would
+	// need its voxels resampled, which the grid does not do. Monocular keyframes carry no
+	// depth, so a monocular run leaves this grid empty and never gets here with keyframes.
+	if (correction.scale != 1.0 && !keyframes().empty())
+		throw std::invalid_argument(
+			"CSubmappedOccupancyGrid3D::applyCorrection: cannot rescale a grid built from depth (scale " +
+			std::to_string(correction.scale) + ", " + std::to_string(keyframes().size()) + " keyframes)");
+	if (correction.scale != 1.0) return false;
 	morphAndMergeSubmaps(correction.poses);
 	return true;
 }

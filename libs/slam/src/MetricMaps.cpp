@@ -2,10 +2,13 @@
 #include <keygrid/slam/IniReference.h>
 #include <keygrid/slam/MetricMaps.h>
 #include <keygrid/slam/SimpleMapExport.h>
+#include <mrpt/math/CQuaternion.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/maps/TMetricMapTypesRegistry.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <chrono>
 #include <future>
 #include <map>
@@ -170,7 +173,7 @@ void MetricMaps::listKeyFrameMaps()
 maps::ExportFrame MetricMaps::outputFrame() const
 {
 	if (m_restoredFloor) return maps::floorExportFrame(*m_restoredFloor);
-	if (m_floor.T_world_floor()) return maps::floorExportFrame(*m_floor.T_world_floor());
+	if (T_world_floor()) return maps::floorExportFrame(*T_world_floor());
 	return {mrpt::poses::CPose3D(), "keygrid frame: SLAM world (the first camera's optical frame; no floor estimate)"};
 }
 
@@ -200,7 +203,7 @@ void MetricMaps::insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, d
 	m_travelled[id] = travelled;
 	// The floor first, so that the keyframe enters the 2D grids in the newest floor frame.
 	// Samples of its depth image, else its map points.
-	if (!m_floor.given())
+	if (!m_floor.given() && !m_floorFromHeight)
 	{
 		std::vector<mrpt::math::TPoint3Df> samples;
 		if (!kf.depth.empty())
@@ -244,12 +247,82 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 		// an older one, see floorReanchorShift).
 		const auto t0 = std::chrono::steady_clock::now();
 		std::map<uint64_t, mrpt::poses::CPose3D> np(newPoses.begin(), newPoses.end());
-		m_floor.updatePoses(np);
-		correction.T_world_floor = m_floor.T_world_floor();
+		if (!m_floorFromHeight) m_floor.updatePoses(np);
+		correction.T_world_floor = T_world_floor();
 		out["floor"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}
 	for (const auto& [id, T] : newPoses)
 		if (m_insertedPoses.count(id)) correction.poses[id] = PoseCorrection{m_insertedPoses.at(id), T};
+	for (const auto& [name, sec] : dispatchCorrection(correction)) out[name] = sec;
+	for (const auto& [id, T] : newPoses)
+		if (m_insertedPoses.count(id)) m_insertedPoses[id] = T;
+	return out;
+}
+
+void MetricMaps::useFloorFromCameraHeight()
+{
+	if (!m_insertedPoses.empty())
+		throw std::logic_error("MetricMaps::useFloorFromCameraHeight: called after keyframes were inserted");
+	m_floorFromHeight = true;
+}
+
+std::map<std::string, double> MetricMaps::applyRescale(
+	const sfm::SparseMap& map, double s, const Eigen::Vector3d& n_floor, double d_floor)
+{
+	if (!(s > 0) || !std::isfinite(s))
+		throw std::invalid_argument("MetricMaps::applyRescale: scale " + std::to_string(s) + " is not a positive finite factor");
+	std::map<std::string, double> out;
+	if (empty()) return out;
+	maps::MapCorrection correction;
+	correction.scale = s;
+	for (auto& [id, T_old] : m_insertedPoses)
+	{
+		mrpt::poses::CPose3D T_new;
+		if (!map.poseOf(id, T_new))
+		{
+			T_new = T_old;  // not in the map any more: it follows the scale only
+			sfm::scaleTranslation(T_new, s);
+		}
+		correction.poses[id] = PoseCorrection{T_old, T_new};
+		T_old = T_new;
+	}
+	for (auto& [id, t] : m_travelled) t *= s;
+	if (m_floorFromHeight && !m_insertedPoses.empty())
+	{
+		// The frame's origin and heading: the first keyframe's footprint and view direction.
+		const auto& first = m_insertedPoses.begin()->second;
+		maps::FloorPlane plane;
+		plane.normal = mrpt::math::TVector3D(n_floor.x(), n_floor.y(), n_floor.z());
+		plane.d = d_floor;
+		m_heightFloor = maps::floorPoseFromPlane(plane, first.translation(), first.rotateVector(mrpt::math::TVector3D(0, 0, 1)));
+	}
+	correction.T_world_floor = T_world_floor();
+	return dispatchCorrection(correction);
+}
+
+std::string MetricMaps::floorJson() const
+{
+	if (!m_floorFromHeight) return m_floor.toJson();
+	std::ostringstream o;
+	o << "{\"source\": \"camera_height\", \"T_world_floor\": ";
+	if (m_heightFloor)
+	{
+		mrpt::math::CQuaternionDouble q;
+		m_heightFloor->getAsQuaternion(q);
+		char b[256];
+		std::snprintf(b, sizeof(b), "[%.9g, %.9g, %.9g, %.9g, %.9g, %.9g, %.9g]", m_heightFloor->x(), m_heightFloor->y(),
+					  m_heightFloor->z(), q.x(), q.y(), q.z(), q.r());
+		o << b;
+	}
+	else
+		o << "null";
+	o << "}";
+	return o.str();
+}
+
+std::map<std::string, double> MetricMaps::dispatchCorrection(const maps::MapCorrection& correction)
+{
+	std::map<std::string, double> out;
 	// The maps are independent of each other: all but the first are re-anchored on threads of
 	// their own (the result does not depend on the order).
 	std::vector<double> seconds(m_keyFrameMaps.size(), -1.0);
@@ -265,8 +338,6 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 	for (auto& f : others) f.get();
 	for (std::size_t i = 0; i < seconds.size(); i++)
 		if (seconds[i] >= 0) out[m_maps.maps[i]->GetRuntimeClass()->className] = seconds[i];
-	for (const auto& [id, T] : newPoses)
-		if (m_insertedPoses.count(id)) m_insertedPoses[id] = T;
 	return out;
 }
 

@@ -47,6 +47,8 @@ std::optional<double> MetricScale::update(sfm::SparseMap& map)
 	m_stats.lastMessage = r.message;
 	if (!r.ok) return std::nullopt;
 	map.rescale(r.scale);
+	// The plane was found in the map before the rescale: its offset scales with the map.
+	m_floorPlane = FloorPlane{r.floorNormal, r.floorOffset * r.scale};
 	m_stats.applied++;
 	m_stats.totalFactor *= r.scale;
 	m_stats.lastFactor = r.scale;

@@ -256,6 +256,13 @@ void System::applyMetricScale(sfm::TrackedFrame& tf)
 	}
 	m_travelled *= *s;
 	if (m_lastTrackedPose) sfm::scaleTranslation(*m_lastTrackedPose, *s);
+	// The maps follow: what they hold is rebuilt in the new scale, on the estimate's floor.
+	if (m_maps && m_metricScale->floorPlane())
+	{
+		const auto& floor = *m_metricScale->floorPlane();
+		for (const auto& [name, sec] : m_maps->applyRescale(m_map, *s, floor.normal, floor.offset))
+			m_timings.add("map_correction:" + name, sec);
+	}
 }
 
 void System::attachInitialKeyFrame(const sfm::TrackedFrame& tf)

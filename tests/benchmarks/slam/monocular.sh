@@ -8,7 +8,12 @@
 # Prints per run: the frame the map started at, frames tracked after it, the ATE of the tracked
 # frames after Sim(3) alignment and as a share of the ground-truth path they cover, the ATE after SE(3) alignment
 # (with a height: the map is metric), the scale error (Sim(3) alignment scale - 1) and the
-# frame rate.
+# frame rate. With a height, on the rendered scenes, the 2D grid (map_2d.yaml, the keyframes' map
+# points on the camera-height floor) is scored against the scene's floor plan by keygrid-eval's
+# map mode, the scorer of the RGB-D grids (tests/benchmarks/maps_ism/nav_safety_sim.sh): hazard
+# cells (interior obstacle cells called free), every obstacle cell called free, obstacle recall
+# over the boundary cells seen and obstacle precision. Without a height the grid is in the map's
+# arbitrary unit and is not scored.
 # Renderings are made once per --out folder; the TUM cases are skipped when their data is absent.
 #
 #   tests/benchmarks/slam/monocular.sh [--build DIR] [--out DIR] [--cases "room office fr1 desk"] [--help]
@@ -20,7 +25,7 @@ build="$root/build"
 out=/tmp/keygrid_monocular
 cases="room office fr1 desk"
 data="$root/../shared/data"
-usage() { sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
 die() { echo "monocular.sh: error: $*" >&2; exit 2; }
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -53,9 +58,10 @@ render() {
   echo "$dir"
 }
 
-# run TAG CONFIG INPUT GT HEIGHT [SET]: one keygrid-slam run and its table row
+# run TAG CONFIG INPUT GT HEIGHT [SCENE [SET]]: one keygrid-slam run and its table row; SCENE (a
+# config/sim scene rendered into the folder of GT) has its 2D grid scored when HEIGHT is given
 run() {
-  local tag="$1" cfg="$2" input="$3" gt="$4" height="$5" set="${6:-}"
+  local tag="$1" cfg="$2" input="$3" gt="$4" height="$5" scene="${6:-}" set="${7:-}"
   local dir="$out/run_$tag"
   rm -rf "$dir"; mkdir -p "$dir"
   local overrides="slam.sensor=monocular"
@@ -81,9 +87,16 @@ PY
     sim3="$("$build/bin/keygrid-eval" --gt "$gt" --est "$dir/trajectory_tracked.txt" --sim3 2>/dev/null || true)"
     se3="$("$build/bin/keygrid-eval" --gt "$gt" --est "$dir/trajectory_tracked.txt" 2>/dev/null || true)"
   fi
-  /usr/bin/python3 - "$dir/report.json" "$gt" "$tag" "$height" "$sim3" "$se3" "$dir/trajectory_tracked.txt" <<'PY'
+  local grid="$dir/eval_map.json"
+  if [ -n "$scene" ] && [ "$height" != 0 ] && [ -f "$dir/map_2d.yaml" ]; then
+    "$build/bin/keygrid-eval" --quiet --gt "$gt" --est "$dir/trajectory.txt" --map "$dir/map_2d.yaml" \
+      --floorplan "$(dirname "$gt")/floorplan.yaml" --scene "$root/config/sim/$scene.ini" \
+      --keyframes "$dir/keyframes.txt" --overlay "$dir/overlay.png" --json "$grid" >"$dir/eval_map.txt" 2>&1 \
+      || echo "monocular.sh: grid scoring failed: $dir/eval_map.txt" >&2
+  fi
+  /usr/bin/python3 - "$dir/report.json" "$gt" "$tag" "$height" "$sim3" "$se3" "$dir/trajectory_tracked.txt" "$grid" <<'PY'
 import json, math, os, re, sys
-report, gt, tag, height, sim3, se3, traj = sys.argv[1:8]
+report, gt, tag, height, sim3, se3, traj, grid = sys.argv[1:9]
 r = json.load(open(report))
 def rows(path):
     if not os.path.exists(path): return []
@@ -106,24 +119,30 @@ a_sim3, a_se3 = ate(sim3), ate(se3)
 scale_err = f"{100 * abs(scale - 1):.2f} %" if height != "0" and scale == scale else "-"
 se3_text = f"{1000 * a_se3:.1f} mm = {100 * a_se3 / path:.2f} %" if height != "0" and a_se3 == a_se3 else "-"
 sim3_text = f"{1000 * a_sim3:.1f} mm = {100 * a_sim3 / path:.2f} %" if a_sim3 == a_sim3 else "-"
+grid_text = "- | - | - | -"
+if os.path.exists(grid):
+    e = json.load(open(grid))
+    grid_text = (f"{e['map_hazard_cells']} of {e['map_interior_obstacle_cells']} | {e['map_obstacle_called_free_cells']} "
+                 f"| {e['map_boundary_recall']:.3f} ({e['map_boundary_cells_seen']} seen) | {e['map_obstacle_precision']:.3f}")
 print(f"| {tag} | {height if height != '0' else '-'} | {start if start is not None else 'never'} "
-      f"| {tracked_after} / {after} | {sim3_text} | {se3_text} | {scale_err} | {r.get('fps', 0):.1f} | {path:.2f} m |")
+      f"| {tracked_after} / {after} | {sim3_text} | {se3_text} | {scale_err} | {r.get('fps', 0):.1f} | {path:.2f} m "
+      f"| {grid_text} |")
 PY
 }
 
-echo "| run | camera_height [m] | map start (frame) | tracked after it | ATE, Sim(3) (share of the path) | ATE, SE(3) | scale error | fps | ground-truth path |"
-echo "|---|---|---|---|---|---|---|---|---|"
+echo "| run | camera_height [m] | map start (frame) | tracked after it | ATE, Sim(3) (share of the path) | ATE, SE(3) | scale error | fps | ground-truth path | 2D grid: hazard cells (interior) | obstacle cells called free | obstacle recall, seen boundary | obstacle precision |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 mono="$root/config/sim_monocular.ini"
 for c in $cases; do
   case "$c" in
     room)
       d="$(render room_loop room_loop)"
       run room_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0
-      run room_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.30 ;;
+      run room_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.30 room_loop ;;
     office)
       d="$(render office_loop office_loop)"
       run office_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0
-      run office_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.40 ;;
+      run office_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.40 office_loop ;;
     fr1|desk)
       seq=tum_fr1_rpy_first250; [ "$c" = desk ] && seq=tum_fr1_desk_9frames
       if [ -f "$data/$seq/groundtruth.txt" ]; then

@@ -147,7 +147,7 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	js["loop_closures"] = loopClosures(sys);
 	if (auto s = session(sys, in)) js["session"] = std::move(*s);
 	js["maps"] = sys.metricMaps() ? parsed(sys.metricMaps()->summaryJson()) : Json::array();
-	js["floor"] = sys.metricMaps() ? parsed(sys.metricMaps()->floor().toJson()) : Json();
+	js["floor"] = sys.metricMaps() ? parsed(sys.metricMaps()->floorJson()) : Json();
 	const double kfs = static_cast<double>(std::max<std::size_t>(1, st.keyframesCreated));
 	js["mean_inliers"] = rounded(st.sumInliers / static_cast<double>(std::max<std::size_t>(1, st.frames)), 1);
 	js["mean_ba_keyframes"] = rounded(st.sumBaKeyFrames / kfs, 1);

@@ -51,6 +51,11 @@ struct MapCorrection
 	/** The run's floor frame under the corrected poses (given, or the newest estimate);
 	 * nullopt while none is known. */
 	std::optional<mrpt::poses::CPose3D> T_world_floor;
+	/** The world was scaled by this factor about its origin (x -> scale x) before the poses
+	 * moved to their corrected values: a monocular map given metric scale. What a map holds in
+	 * a keyframe's camera frame (map points, rays) scales by it, and so does the translation of
+	 * every keyframe pose the correction does not name. 1 for a loop closure or a refinement. */
+	double scale{1.0};
 };
 
 /** The frontend's landmarks (positions, descriptors, Histograms of Oriented Cameras) as a HOC

@@ -19,6 +19,14 @@
  * when it changes); map_3d.bt/.ply and hoc_points.ply are written in it. The
  * maps themselves (and their serialized .bin files) stay in the SLAM world, where loop
  * closures re-anchor them.
+ *
+ * Monocular keyframes carry no depth: the 2D grid takes their map points (the landmarks each
+ * observes; a ray from the camera to each), the 3D grid and MRPT's depth-fed maps get nothing.
+ * With a camera height (slam::MetricScale) the floor frame is the floor plane that estimate
+ * found (useFloorFromCameraHeight), and each rescale of the map reaches the maps as a
+ * correction with a scale (applyRescale): everything inserted before is rebuilt in the new
+ * scale. Without one, the floor estimator runs on the map points and the maps share the map's
+ * arbitrary unit.
  */
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CHOCPointsMap.h>
@@ -84,10 +92,30 @@ class MetricMaps
 
 	/** The run's floor frame (given or estimated; none before the first estimate). */
 	const maps::FloorFrameEstimator& floor() const { return m_floor; }
-	const std::optional<mrpt::poses::CPose3D>& T_world_floor() const { return m_floor.T_world_floor(); }
+	const std::optional<mrpt::poses::CPose3D>& T_world_floor() const
+	{
+		return m_floorFromHeight ? m_heightFloor : m_floor.T_world_floor();
+	}
+	/** report.json's "floor": the estimator's (FloorFrameEstimator::toJson), or with the floor
+	 * from the camera height {"source": "camera_height", "T_world_floor": ...}. */
+	std::string floorJson() const;
+
+	/** Monocular with a camera height: the floor frame is the floor plane of the camera-height
+	 * estimate (applyRescale), not the floor estimator's, whose metric tolerances do not fit a
+	 * map before its first metric scale. Until the first applyRescale there is no floor frame,
+	 * and the 2D grids only store their keyframes. Before the first keyframe. */
+	void useFloorFromCameraHeight();
+	/** The map was scaled by `s` about its origin (SparseMap::rescale) and its floor plane is
+	 * n . p + d = 0 (as the map is now, n towards the cameras): every map rebuilds what it
+	 * holds at the keyframes' poses now in `map`, its stored points scaled by s, in the floor
+	 * frame of that plane (when useFloorFromCameraHeight). Returns seconds per map name, as
+	 * applyCorrection. Throws std::invalid_argument for s not positive and finite. */
+	std::map<std::string, double> applyRescale(
+		const sfm::SparseMap& map, double s, const Eigen::Vector3d& n_floor, double d_floor);
 
 	/** Inserts keyframe `kf` (pose as now in the map) into every map and its depth samples
-	 * (its map points when it has no depth) into the floor estimate. `travelled` is the
+	 * (its map points when it has no depth) into the floor estimate (none with
+	 * useFloorFromCameraHeight). `travelled` is the
 	 * camera's path length so far [m]. */
 	void insertKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId kf, double travelled);
 
@@ -136,6 +164,9 @@ class MetricMaps
 	maps::FloorFrameEstimator m_floor;
 	/** FromMaps(): the floor frame of the run that built the maps */
 	std::optional<mrpt::poses::CPose3D> m_restoredFloor;
+	/** See useFloorFromCameraHeight(); m_heightFloor: the frame of the last applyRescale. */
+	bool m_floorFromHeight{false};
+	std::optional<mrpt::poses::CPose3D> m_heightFloor;
 
 	const KeyFrameImageSource* m_images{nullptr};
 	/** Fills m_keyFrameMaps from m_maps (one dynamic_cast per map). */
@@ -144,6 +175,9 @@ class MetricMaps
 	maps::MapKeyFrame mapKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, double travelled) const;
 	/** The keyframe's depth, from m_images when the keyframe dropped it. */
 	cv::Mat depthOf(const sfm::KeyFrame& kf) const;
+	/** Hands `correction` to every map (all but the first on threads of their own); seconds per
+	 * map that re-anchored, by class name. */
+	std::map<std::string, double> dispatchCorrection(const maps::MapCorrection& correction);
 	/** The frame map outputs are written in: the floor frame, else the SLAM world. */
 	maps::ExportFrame outputFrame() const;
 };

@@ -66,6 +66,14 @@ class MetricScale
 		std::string lastMessage;  //!< the last estimate's result text
 	};
 	const Stats& stats() const { return m_stats; }
+	/** The floor plane of the last applied estimate, n . p + offset = 0 in the map as it is
+	 * now (metres; n unit, towards the cameras); nullopt before the first. */
+	struct FloorPlane
+	{
+		Eigen::Vector3d normal;
+		double offset{0};
+	};
+	const std::optional<FloorPlane>& floorPlane() const { return m_floorPlane; }
 	/** The map is in metres: an estimate was applied. */
 	bool metric() const { return m_stats.applied > 0; }
 
@@ -75,6 +83,7 @@ class MetricScale
 	/** Newest keyframe id at the last estimate (ids only grow: culling does not reset it) */
 	std::optional<sfm::KeyFrameId> m_lastEstimateAt;
 	Stats m_stats;
+	std::optional<FloorPlane> m_floorPlane;  //!< see floorPlane()
 };
 
 }  // namespace keygrid::slam

@@ -83,11 +83,14 @@ class System
 	/** extract + processExtracted. */
 	const sfm::TrackedFrame& process(const core::Frame& frame);
 
-	/** Maps fed with every keyframe (optional; see MetricMaps). */
+	/** Maps fed with every keyframe (optional; see MetricMaps). Monocular with a camera
+	 * height: their floor frame is the camera-height estimate's floor, and they follow every
+	 * rescale of the map. */
 	void attachMaps(std::unique_ptr<MetricMaps> maps)
 	{
 		m_maps = std::move(maps);
 		if (m_maps) m_maps->setImageSource(m_images.get());
+		if (m_maps && m_metricScale) m_maps->useFloorFromCameraHeight();
 	}
 	const MetricMaps* metricMaps() const { return m_maps.get(); }
 
