@@ -56,17 +56,6 @@ core::OptionFields CHOCPointsMap::TInsertionOptions::fields()
 	return f;
 }
 
-void CHOCPointsMap::TInsertionOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	core::validateFields(*this, s);
-}
-
-void CHOCPointsMap::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
-}
-
 core::OptionFields CHOCPointsMap::TLikelihoodOptions::fields()
 {
 	using R = core::OptionRule;
@@ -75,17 +64,6 @@ core::OptionFields CHOCPointsMap::TLikelihoodOptions::fields()
 	f.add("sigma", sigma, "[m] std. dev. of the point distance", R::positive());
 	f.add("outlier_probability", outlierProbability, "floor of one pixel's likelihood", R::between(0, 1));
 	return f;
-}
-
-void CHOCPointsMap::TLikelihoodOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	core::validateFields(*this, s);
-}
-
-void CHOCPointsMap::TLikelihoodOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
 }
 
 // ---------------------------------------------------------------- points

@@ -35,17 +35,6 @@ core::OptionFields CISMOccupancyGrid2D::TCreationOptions::fields()
 	return f;
 }
 
-void CISMOccupancyGrid2D::TCreationOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void CISMOccupancyGrid2D::TCreationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
-}
-
 void CISMOccupancyGrid2D::TCreationOptions::validate(const std::string& s) const
 {
 	core::validateFields(*this, s);
@@ -135,17 +124,6 @@ core::OptionFields CISMOccupancyGrid2D::TInsertionOptions::fields()
 	return f;
 }
 
-void CISMOccupancyGrid2D::TInsertionOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void CISMOccupancyGrid2D::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
-}
-
 void CISMOccupancyGrid2D::TInsertionOptions::validate(const std::string& s) const
 {
 	core::validateFields(*this, s);  // also the floorRansac_ keys
@@ -173,17 +151,6 @@ core::OptionFields CISMOccupancyGrid2D::TLikelihoodOptions::fields()
 	f.add("decimation", decimation, "use every n-th depth pixel in rows and columns", R::atLeast(1));
 	f.add("outlierProbability", outlierProbability, "eps of each obstacle-band point's likelihood eps + (1 - eps) p(cell)", R::between(0, 1));
 	return f;
-}
-
-void CISMOccupancyGrid2D::TLikelihoodOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void CISMOccupancyGrid2D::TLikelihoodOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
 }
 
 void CISMOccupancyGrid2D::TLikelihoodOptions::validate(const std::string& s) const { core::validateFields(*this, s); }

@@ -73,17 +73,6 @@ core::OptionFields CSubmappedOccupancyGrid3D::TInsertionOptions::fields()
 	return f;
 }
 
-void CSubmappedOccupancyGrid3D::TInsertionOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void CSubmappedOccupancyGrid3D::TInsertionOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
-}
-
 void CSubmappedOccupancyGrid3D::TInsertionOptions::validate(const std::string& s) const
 {
 	integration.validate(s);
@@ -98,17 +87,6 @@ core::OptionFields CSubmappedOccupancyGrid3D::TLikelihoodOptions::fields()
 	f.add("maxRange", maxRange, "pixels farther than this from the camera centre are left out [m]", R::positive());
 	f.add("minProbability", minProbability, "floor of each pixel's occupancy probability (unknown voxels: 0.5)", R::between(0, 0.5));
 	return f;
-}
-
-void CSubmappedOccupancyGrid3D::TLikelihoodOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void CSubmappedOccupancyGrid3D::TLikelihoodOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
 }
 
 void CSubmappedOccupancyGrid3D::TLikelihoodOptions::validate(const std::string& s) const { core::validateFields(*this, s); }

@@ -72,14 +72,6 @@ void HocOptions::validate(const std::string& s) const
 			"[" + s + "] visible_depth_max = " + std::to_string(visibleDepthMax) + " (must be > visible_depth_min = " + std::to_string(visibleDepthMin) + ")");
 }
 
-void HocOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void HocOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void HocHistogram::add(int bin, int delta, int limit, int numBins)
 {
 	if (bin < 0 || bin >= numBins) throw std::out_of_range("HOC bin " + std::to_string(bin) + " outside [0, " + std::to_string(numBins) + ")");

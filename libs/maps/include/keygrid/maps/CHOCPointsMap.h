@@ -21,10 +21,10 @@
  * frontend's landmarks (syncLandmarks) and takes nothing from keyframes or corrections itself.
  */
 #include <keygrid/maps/ExportFrame.h>
+#include <keygrid/maps/FieldTableOptions.h>
 #include <keygrid/maps/HocGeometry.h>
 #include <keygrid/maps/HocHistogram.h>
 #include <keygrid/maps/KeyFrameMap.h>
-#include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/CMetricMap.h>
 #include <mrpt/math/TPoint3D.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -52,7 +52,7 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 	};
 
 	/** insertObservation() of depth scans. INI section `_insertOpts`. */
-	struct TInsertionOptions : public mrpt::config::CLoadableOptions
+	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
 	{
 		/** Use every n-th pixel in rows and columns (Default: 8) */
 		int decimation{8};
@@ -63,14 +63,12 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 
 		/** Its keys (OptionFields.h). */
 		core::OptionFields fields();
-		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
-		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 	};
 
 	/** Likelihood of a depth scan: product over decimated pixels of a Gaussian of the distance
 	 * to the nearest map point (searched in the 27 neighbouring spacing-voxels), floored.
 	 * INI section `_likelihoodOpts`. */
-	struct TLikelihoodOptions : public mrpt::config::CLoadableOptions
+	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
 	{
 		int decimation{16};  //!< (Default: 16)
 		double sigma{0.05};  //!< [m] (Default: 0.05)
@@ -78,8 +76,6 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 
 		/** Its keys (OptionFields.h). */
 		core::OptionFields fields();
-		void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
-		void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 	};
 
 	/** Visualization: points coloured by their largest bin weight (red 0 .. green 1) and,

@@ -4,10 +4,10 @@
  * model of Lu & Wang (2018). MRPT CMetricMap plugin registered as "ismOccupancyGrid2D".
  */
 #include <keygrid/core/OptionFields.h>
+#include <keygrid/maps/FieldTableOptions.h>
 #include <keygrid/maps/FloorPlaneEstimator.h>
 #include <keygrid/maps/InverseSensorModel.h>
 #include <keygrid/maps/KeyFrameMap.h>
-#include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/CMetricMap.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/math/TPoint3D.h>
@@ -66,7 +66,7 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 
    public:
 	/** Creation options: the grid geometry. */
-	struct TCreationOptions : public mrpt::config::CLoadableOptions
+	struct TCreationOptions : public maps::FieldTableOptions<TCreationOptions>
 	{
 		/** Cell size [m] (Default: 0.05 m) */
 		double resolution{0.05};
@@ -77,10 +77,6 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 
 		/** The INI keys (MRPT's COccupancyGridMap2D names), with description and rule. */
 		core::OptionFields fields();
-		void loadFromConfigFile(
-			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
-		void saveToConfigFile(
-			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
 		void validate(const std::string& section = "creationOpts") const;
 	};
@@ -107,7 +103,7 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	};
 
 	/** Insertion options: ISM, noise, height band, floor frame, traversal, thresholds. */
-	struct TInsertionOptions : public mrpt::config::CLoadableOptions
+	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
 	{
 		/** Ideal-model occupancy before the band (Default: 0.30) */
 		double pFree{0.30};
@@ -167,16 +163,12 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 
 		/** The INI keys (floorRansac's prefixed "floorRansac_"), with description and rule. */
 		core::OptionFields fields();
-		void loadFromConfigFile(
-			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
-		void saveToConfigFile(
-			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
 		void validate(const std::string& section = "insertOpts") const;
 	};
 
 	/** Likelihood options for computeObservationLikelihood(CObservation3DRangeScan). */
-	struct TLikelihoodOptions : public mrpt::config::CLoadableOptions
+	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
 	{
 		/** Use every n-th depth pixel in rows and columns (Default: 8) */
 		int decimation{8};
@@ -184,10 +176,6 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 		double outlierProbability{0.05};
 
 		core::OptionFields fields();
-		void loadFromConfigFile(
-			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
-		void saveToConfigFile(
-			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
 		void validate(const std::string& section = "likelihoodOpts") const;
 	};

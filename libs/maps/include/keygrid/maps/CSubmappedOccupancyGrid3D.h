@@ -28,10 +28,10 @@
 #include <keygrid/maps/ConflictDetector.h>
 #include <keygrid/maps/DepthFrameIntegrator.h>
 #include <keygrid/maps/ExportFrame.h>
+#include <keygrid/maps/FieldTableOptions.h>
 #include <keygrid/maps/GridMorphing.h>
 #include <keygrid/maps/KeyFrameMap.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
-#include <mrpt/config/CLoadableOptions.h>
 #include <mrpt/maps/CMetricMap.h>
 #include <mrpt/poses/CPose3D.h>
 #include <opencv2/core/mat.hpp>
@@ -87,7 +87,7 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	};
 
 	/** Options of observation insertion (INI section `..._insertOpts`). */
-	struct TInsertionOptions : public mrpt::config::CLoadableOptions
+	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
 	{
 		DepthIntegrationOptions integration;
 		ConflictOptions conflict;
@@ -99,16 +99,12 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 
 		/** The INI keys of integration, conflict and this struct, with description and rule. */
 		core::OptionFields fields();
-		void loadFromConfigFile(
-			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
-		void saveToConfigFile(
-			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
 		void validate(const std::string& section = "insertOpts") const;
 	};
 
 	/** Options of computeObservationLikelihood (INI section `..._likelihoodOpts`). */
-	struct TLikelihoodOptions : public mrpt::config::CLoadableOptions
+	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
 	{
 		/** Use every N-th pixel in u and v (Default: 10) */
 		unsigned decimation{10};
@@ -118,10 +114,6 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 		double minProbability{0.05};
 
 		core::OptionFields fields();
-		void loadFromConfigFile(
-			const mrpt::config::CConfigFileBase& source, const std::string& section) override;
-		void saveToConfigFile(
-			mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
 		void validate(const std::string& section = "likelihoodOpts") const;
 	};

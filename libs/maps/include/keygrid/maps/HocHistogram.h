@@ -14,7 +14,7 @@
  * while p(n_b) > select_threshold; it is removed from the map when max_b p(n_b) < prune_threshold.
  */
 #include <keygrid/core/OptionFields.h>
-#include <mrpt/config/CLoadableOptions.h>
+#include <keygrid/maps/FieldTableOptions.h>
 
 #include <cstdint>
 #include <string>
@@ -22,7 +22,7 @@
 
 namespace keygrid::maps
 {
-struct HocOptions : public mrpt::config::CLoadableOptions
+struct HocOptions : public maps::FieldTableOptions<HocOptions>
 {
 	/** Use the HOC in the frontend; false gives the standard (static-world) system, for
 	 * comparisons (Default: false) */
@@ -70,8 +70,6 @@ struct HocOptions : public mrpt::config::CLoadableOptions
 	keygrid::core::OptionFields fields();
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "hoc") const;
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section) override;
-	void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override;
 };
 
 /** Counts of one point; storage is allocated on the first update (an untouched point costs
