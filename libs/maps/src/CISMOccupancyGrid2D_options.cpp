@@ -153,6 +153,4 @@ core::OptionFields CISMOccupancyGrid2D::TLikelihoodOptions::fields()
 	return f;
 }
 
-void CISMOccupancyGrid2D::TLikelihoodOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
-
 }  // namespace keygrid

@@ -89,8 +89,6 @@ core::OptionFields CSubmappedOccupancyGrid3D::TLikelihoodOptions::fields()
 	return f;
 }
 
-void CSubmappedOccupancyGrid3D::TLikelihoodOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
-
 // ---------------------------------------------------------------- basics
 CSubmappedOccupancyGrid3D::CSubmappedOccupancyGrid3D(double resolution)
 {

@@ -176,8 +176,6 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 		double outlierProbability{0.05};
 
 		core::OptionFields fields();
-		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
-		void validate(const std::string& section = "likelihoodOpts") const;
 	};
 
 	/** One keyframe's stored rays: camera pose and ray endpoints in the optical frame. */

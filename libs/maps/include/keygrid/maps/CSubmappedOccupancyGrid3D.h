@@ -114,8 +114,6 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 		double minProbability{0.05};
 
 		core::OptionFields fields();
-		/** Throws std::invalid_argument naming [section], key and value on a bad value. */
-		void validate(const std::string& section = "likelihoodOpts") const;
 	};
 
 	TInsertionOptions insertionOptions;
