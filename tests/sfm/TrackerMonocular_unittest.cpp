@@ -198,58 +198,66 @@ TEST(TrackerMonocular, APureRotationNeverStartsAMapAndTheReferenceIsRenewed)
 // the cameras, and the two-view initializer refuses them as ambiguous at any parallax. The
 // true motion's plane is the same from every current frame, the other one turns with the
 // direction of travel: on a curved path a later frame picks the true motion, and the map is
-// the ground truth's up to its scale.
+// the ground truth's up to its scale. With the two-view rival rule on (the default,
+// TwoViewOptions::rivalParallaxShare) the plane's second, rotation-like motion is no rival and
+// the true map starts without an ambiguous frame; the plane rule is tested with it off.
 TEST(TrackerMonocular, AWallInViewIsResolvedByThePlaneAndStartsTheTrueMap)
 {
-	const core::RgbdCamera cam;
-	std::mt19937 rng(10);
-	// A wall 3 m ahead, tilted 20 deg about the vertical, filling the first image.
-	test::SyntheticPoints wall;
-	std::uniform_real_distribution<double> x(-2.5, 2.5), y(-1.8, 1.8);
-	for (int i = 0; i < kWorldPoints; i++)
+	for (const bool rivalRule : {false, true})
 	{
-		const double u = x(rng);
-		wall.p_world.emplace_back(u * std::cos(0.35), y(rng), 3.0 + u * std::sin(0.35));
-	}
-	wall.descriptors = test::randomDescriptors(kWorldPoints, rng);
-	// A curved path: the direction of travel turns by about 2 deg a frame.
-	const auto pose = [](int i) {
-		const double s = static_cast<double>(i), a = 0.035 * s;
-		return CPose3D(0.6 * std::sin(a), 0.001 * s, 0.6 * (1 - std::cos(a)), -0.5 * a, 0.0, 0.0);
-	};
-	sfm::SparseMap map;
-	auto opts = monocularOptions();
-	opts.mono.initPlaneNormalDeg = 1.5;
-	sfm::Tracker tracker(map, opts);
-	std::optional<int> startFrame;
-	bool sawAmbiguous = false;
-	double scale = 0;
-	for (int i = 0; i < 40; i++)
-	{
-		const CPose3D T_gt = pose(i);
-		auto m = observe(wall, i, T_gt, cam, rng);
-		const auto tf = tracker.track(m.frame, std::move(m.features));
-		if (!startFrame && !tf.tracked)
+		SCOPED_TRACE(rivalRule ? "rival rule" : "plane rule");
+		const core::RgbdCamera cam;
+		std::mt19937 rng(10);
+		// A wall 3 m ahead, tilted 20 deg about the vertical, filling the first image.
+		test::SyntheticPoints wall;
+		std::uniform_real_distribution<double> x(-2.5, 2.5), y(-1.8, 1.8);
+		for (int i = 0; i < kWorldPoints; i++)
 		{
-			sawAmbiguous |= tf.initMessage.find("ambiguous") != std::string::npos;
-			continue;
+			const double u = x(rng);
+			wall.p_world.emplace_back(u * std::cos(0.35), y(rng), 3.0 + u * std::sin(0.35));
 		}
-		if (!startFrame)
+		wall.descriptors = test::randomDescriptors(kWorldPoints, rng);
+		// A curved path: the direction of travel turns by about 2 deg a frame.
+		const auto pose = [](int i) {
+			const double s = static_cast<double>(i), a = 0.035 * s;
+			return CPose3D(0.6 * std::sin(a), 0.001 * s, 0.6 * (1 - std::cos(a)), -0.5 * a, 0.0, 0.0);
+		};
+		sfm::SparseMap map;
+		auto opts = monocularOptions();
+		opts.mono.initPlaneNormalDeg = 1.5;
+		if (!rivalRule) opts.mono.twoView.rivalParallaxShare = 0;
+		sfm::Tracker tracker(map, opts);
+		std::optional<int> startFrame;
+		bool sawAmbiguous = false;
+		double scale = 0;
+		for (int i = 0; i < 40; i++)
 		{
-			startFrame = i;
-			ASSERT_EQ(tf.method, sfm::TrackingMethod::Init);
-			EXPECT_NE(tf.initMessage.find("the plane of the first ambiguous frame picked the motion"), std::string::npos) << tf.initMessage;
-			scale = T_gt.translation().norm() / tf.T_world_cam.translation().norm();
+			const CPose3D T_gt = pose(i);
+			auto m = observe(wall, i, T_gt, cam, rng);
+			const auto tf = tracker.track(m.frame, std::move(m.features));
+			if (!startFrame && !tf.tracked)
+			{
+				sawAmbiguous |= tf.initMessage.find("ambiguous") != std::string::npos;
+				continue;
+			}
+			if (!startFrame)
+			{
+				startFrame = i;
+				ASSERT_EQ(tf.method, sfm::TrackingMethod::Init);
+				const bool byPlane = tf.initMessage.find("the plane of the first ambiguous frame picked the motion") != std::string::npos;
+				EXPECT_EQ(byPlane, !rivalRule) << tf.initMessage;
+				scale = T_gt.translation().norm() / tf.T_world_cam.translation().norm();
+			}
+			ASSERT_TRUE(tf.tracked) << "frame " << i;
+			const CPose3D T_est = tf.T_world_cam;
+			const Eigen::Vector3d t_est = scale * Eigen::Vector3d(T_est.x(), T_est.y(), T_est.z());
+			const Eigen::Vector3d t_gt(T_gt.x(), T_gt.y(), T_gt.z());
+			// Exact measurements: the true motion up to the map's scale (the other motion of the
+			// plane would be off by the whole baseline).
+			EXPECT_LT((t_est - t_gt).norm(), 1e-3) << "frame " << i;
+			EXPECT_LT(test::rotationAngleDeg(T_est - T_gt), 1e-2) << "frame " << i;
 		}
-		ASSERT_TRUE(tf.tracked) << "frame " << i;
-		const CPose3D T_est = tf.T_world_cam;
-		const Eigen::Vector3d t_est = scale * Eigen::Vector3d(T_est.x(), T_est.y(), T_est.z());
-		const Eigen::Vector3d t_gt(T_gt.x(), T_gt.y(), T_gt.z());
-		// Exact measurements: the true motion up to the map's scale (the other motion of the
-		// plane would be off by the whole baseline).
-		EXPECT_LT((t_est - t_gt).norm(), 1e-3) << "frame " << i;
-		EXPECT_LT(test::rotationAngleDeg(T_est - T_gt), 1e-2) << "frame " << i;
+		EXPECT_EQ(sawAmbiguous, !rivalRule);
+		ASSERT_TRUE(startFrame.has_value());
 	}
-	EXPECT_TRUE(sawAmbiguous);
-	ASSERT_TRUE(startFrame.has_value());
 }

@@ -58,23 +58,29 @@ CPose3D circlePose(int k, double height)
 	return camera(0.4 * std::cos(a), 0.4 * std::sin(a), height, a);
 }
 
-/** A room of 4 x 4 map units: floor points (z = 0) and wall points, observed by keyframe `kf`. */
-void addRoom(sfm::SparseMap& map, sfm::KeyFrameId kf)
+/** A room of 4 x 4 map units: floor points (z = 0) and wall points, observed by keyframe `kf`
+ * and, as the frontend triangulates them, by keyframe `witness` from elsewhere (keypoints
+ * from `firstKeypoint` on in both). */
+void addRoom(sfm::SparseMap& map, sfm::KeyFrameId kf, sfm::KeyFrameId witness, int firstKeypoint = 0)
 {
 	std::mt19937 rng(5);
 	// Walls start above the floor's inlier band: their feet would lift the fitted floor.
 	std::uniform_real_distribution<double> u(-2, 2), h(0.1, 1.2);
-	int kp = 0;
-	for (int i = 0; i < 1500; i++) map.addLandmark({u(rng), u(rng), 0.0}, kf, kp++);
+	int kp = firstKeypoint;
+	const auto add = [&](const Eigen::Vector3d& p)
+	{
+		map.addObservation(map.addLandmark(p, kf, kp), witness, kp);
+		kp++;
+	};
+	for (int i = 0; i < 1500; i++) add({u(rng), u(rng), 0.0});
 	for (int i = 0; i < 1000; i++)
 	{
 		const double along = u(rng);
 		const int wall = i % 4;
-		const Eigen::Vector3d p = wall == 0 ? Eigen::Vector3d(2, along, h(rng))
-								  : wall == 1 ? Eigen::Vector3d(-2, along, h(rng))
-								  : wall == 2 ? Eigen::Vector3d(along, 2, h(rng))
-											  : Eigen::Vector3d(along, -2, h(rng));
-		map.addLandmark(p, kf, kp++);
+		add(wall == 0	? Eigen::Vector3d(2, along, h(rng))
+			: wall == 1 ? Eigen::Vector3d(-2, along, h(rng))
+			: wall == 2 ? Eigen::Vector3d(along, 2, h(rng))
+						: Eigen::Vector3d(along, -2, h(rng)));
 	}
 }
 
@@ -92,9 +98,8 @@ TEST(MetricScale, RescalesTheMapToTheCameraHeightAndReestimatesEveryNKeyFrames)
 	sfm::SparseMap map;
 	slam::MetricScale scale(options());
 	const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2500)).id;
-	addRoom(map, first);
 	// Fewer keyframes than min_keyframes (3): nothing is tried.
-	map.addKeyFrame(keyFrame(circlePose(1, kHeightMap), 10));
+	addRoom(map, first, map.addKeyFrame(keyFrame(circlePose(6, kHeightMap), 2500)).id);
 	EXPECT_FALSE(scale.update(map).has_value());
 	EXPECT_EQ(scale.stats().estimates, 0);
 	for (int k = 2; k < 12; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
@@ -126,7 +131,8 @@ TEST(MetricScale, EstimatesAgainRightAfterARequest)
 {
 	sfm::SparseMap map;
 	slam::MetricScale scale(options());
-	addRoom(map, map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2500)).id);
+	const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2500)).id;
+	addRoom(map, first, map.addKeyFrame(keyFrame(circlePose(6, kHeightMap), 2500)).id);
 	for (int k = 1; k < 12; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
 	ASSERT_TRUE(scale.update(map).has_value()) << scale.stats().lastMessage;
 	// The map grows by 10 % (as a correction could leave it): not due yet, unless requested.
@@ -146,7 +152,7 @@ TEST(MetricScale, IsRetriedAtEveryKeyFrameUntilTheFloorIsFound)
 	sfm::SparseMap map;
 	slam::MetricScale scale(options());
 	// No floor yet (walls only above the cameras' horizontal): refused, the map unchanged.
-	const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 10)).id;
+	const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2510)).id;
 	for (int i = 0; i < 10; i++) map.addLandmark({2.0, 0.1 * i, 1.0}, first, i);
 	for (int k = 1; k < 4; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
 	EXPECT_FALSE(scale.update(map).has_value());
@@ -154,12 +160,47 @@ TEST(MetricScale, IsRetriedAtEveryKeyFrameUntilTheFloorIsFound)
 	EXPECT_FALSE(scale.metric());
 	EXPECT_NEAR(map.keyframe(first).T_world_cam.z(), kHeightMap, 1e-15);
 	// The next keyframe brings the floor: tried again at once.
-	const auto withRoom = map.addKeyFrame(keyFrame(circlePose(4, kHeightMap), 2500)).id;
-	addRoom(map, withRoom);
+	const auto withRoom = map.addKeyFrame(keyFrame(circlePose(4, kHeightMap), 2510)).id;
+	addRoom(map, withRoom, first, 10);
 	const auto s = scale.update(map);
 	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
 	EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
 	EXPECT_EQ(scale.stats().estimates, 2);
+}
+
+// Points triangulated over a short baseline (here 1 mm of map units: rays 0.03 deg apart)
+// may lie far off their surface: 200 of them scattered under the floor would make every
+// plane "not the floor", and min_point_parallax_deg leaves them out.
+TEST(MetricScale, PointsSeenOverAShortBaselineAreLeftOutOfTheFloorSearch)
+{
+	for (const double minParallax : {2.0, 0.0})
+	{
+		SCOPED_TRACE(minParallax);
+		sfm::SparseMap map;
+		const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2700)).id;
+		addRoom(map, first, map.addKeyFrame(keyFrame(circlePose(6, kHeightMap), 2500)).id);
+		CPose3D near = circlePose(0, kHeightMap);
+		near.x_incr(0.001);
+		const auto close = map.addKeyFrame(keyFrame(near, 2700)).id;
+		std::mt19937 rng(9);
+		std::uniform_real_distribution<double> u(-1.5, 1.5), under(-0.6, -0.2);
+		for (int i = 0; i < 200; i++) map.addObservation(map.addLandmark({u(rng), u(rng), under(rng)}, first, 2500 + i), close, 2500 + i);
+		for (int k = 1; k < 12; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
+		auto o = options();
+		o.minPointParallaxDeg = minParallax;
+		slam::MetricScale scale(o);
+		const auto s = scale.update(map);
+		if (minParallax > 0)
+		{
+			ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+			EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
+		}
+		else
+		{
+			EXPECT_FALSE(s.has_value());
+			EXPECT_NE(scale.stats().lastMessage.find("floor not seen"), std::string::npos) << scale.stats().lastMessage;
+		}
+	}
 }
 
 TEST(MetricScale, NeedsACameraHeightAndValidOptions)

@@ -29,6 +29,8 @@ core::OptionFields TwoViewOptions::fields()
 	f.add("min_triangulated", minTriangulated, "map points needed", R::inRange(1, 1000000));
 	f.add("min_good_share", minGoodShare, "share of inliers the chosen motion must explain", R::inRange(0, 1));
 	f.add("max_second_best_share", maxSecondBestShare, "second-best / best good points above: ambiguous", R::aboveUpTo(0, 1));
+	f.add("rival_parallax_share", rivalParallaxShare, "a competing motion below min_parallax_deg and this share of the best's parallax is no rival; 0 = off", R::inRange(0, 1));
+	f.add("rival_max_rotation_ratio", rivalMaxRotationRatio, "... when the best motion's rotation is at most this many times its parallax", R::positive());
 	f.add("homography_ratio", homographyRatio, "R_H = S_H / (S_H + S_F) above: homography", R::between(0, 1));
 	f.add("homography_inlier_share", homographyInlierShare, "H inliers / F inliers from which F is degenerate", R::aboveUpTo(0, 1));
 	f.add("parallel", parallel, "score H and F in parallel");
@@ -168,9 +170,10 @@ Eigen::Vector3d planeNormal(const std::vector<Eigen::Vector3d>& points, const st
 /* The best hypothesis (most good points, refined) is accepted when, in this order of diagnosis:
  * it triangulates at least min_triangulated points, its median parallax reaches
  * min_parallax_deg (else: pure rotation or a too short baseline; checked before ambiguity
- * because then t is unobservable and its hypotheses tie), no other hypothesis comes close
- * (second / best <= max_second_best_share, both before refinement), it explains
- * min_good_share of the inliers and has min_triangulated valid points. */
+ * because then t is unobservable and its hypotheses tie), no rival comes close (second /
+ * best <= max_second_best_share, both before refinement; a rotation-like hypothesis is no
+ * rival, see rival_parallax_share), it explains min_good_share of the inliers and has
+ * min_triangulated valid points. */
 TwoViewResult chooseMotion(TwoViewResult r, const detail::WeightedMatches& w, const PinholeIntrinsics& K, const TwoViewOptions& o)
 {
 	TwoViewFailure why = TwoViewFailure::None;
@@ -184,8 +187,6 @@ TwoViewResult chooseMotion(TwoViewResult r, const detail::WeightedMatches& w, co
 		checks.push_back(detail::checkMotion(hs[k], K, w, r.inliers, o));
 		if (checks[k].good > checks[best].good) best = k;
 	}
-	for (std::size_t k = 0; k < hs.size(); k++)
-		if (k != best) r.secondGood = std::max(r.secondGood, checks[k].good);
 	// The linear estimates (8-point, DLT) are algebraic fits, several times less accurate than
 	// the noise allows, and their gates cut good points: refine the best motion on the
 	// model's inliers (Sampson error, re-gated on the refined motion: see refineMotion) and
@@ -201,6 +202,18 @@ TwoViewResult chooseMotion(TwoViewResult r, const detail::WeightedMatches& w, co
 		r.inliers = mask;
 		r.numInliers = static_cast<int>(std::count(mask.begin(), mask.end(), uint8_t{1}));
 	}
+	// Rivals of the best: the other hypotheses, less those that read the views as nearly a
+	// rotation when the best reads a clear translation (rival_parallax_share,
+	// rival_max_rotation_ratio).
+	const double rotationDeg = Eigen::AngleAxisd(r.motion.R_cur_ref).angle() * 180.0 / M_PI;
+	const bool translating = o.rivalParallaxShare > 0 && rotationDeg <= o.rivalMaxRotationRatio * b.medianParallaxDeg;
+	const auto isRival = [&](std::size_t k)
+	{
+		const double p = checks[k].medianParallaxDeg;
+		return k != best && !(translating && p < o.minParallaxDeg && p < o.rivalParallaxShare * b.medianParallaxDeg);
+	};
+	for (std::size_t k = 0; k < hs.size(); k++)
+		if (isRival(k)) r.secondGood = std::max(r.secondGood, checks[k].good);
 	r.bestGood = b.good;
 	r.parallaxDeg = b.medianParallaxDeg;
 	r.numTriangulated = b.numValid;
@@ -215,7 +228,7 @@ TwoViewResult chooseMotion(TwoViewResult r, const detail::WeightedMatches& w, co
 	{
 		for (std::size_t k = 0; k < hs.size(); k++)
 		{
-			if (k != best && !(checks[k].good > o.maxSecondBestShare * checks[best].good)) continue;
+			if (k != best && !(isRival(k) && checks[k].good > o.maxSecondBestShare * checks[best].good)) continue;
 			const auto& c = k == best ? b : checks[k];
 			TwoViewCandidate cand;
 			cand.motion = k == best ? r.motion : hs[k];

@@ -1,6 +1,9 @@
 #include <keygrid/slam/MetricScale.h>
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <algorithm>
+#include <cmath>
+#include <optional>
 #include <vector>
 
 namespace keygrid::slam
@@ -8,6 +11,7 @@ namespace keygrid::slam
 core::OptionFields MetricScaleOptions::fields()
 {
 	core::OptionFields f = estimator.fields();
+	f.add("min_point_parallax_deg", minPointParallaxDeg, "map points seen under rays less far apart are left out of the floor search [deg]; 0 = all", core::OptionRule::fromBelow(0, 90));
 	f.add("reestimate_every", reestimateEvery, "after the first estimate, estimate and rescale again every this many keyframes", core::OptionRule::positive());
 	return f;
 }
@@ -26,6 +30,27 @@ void MetricScaleOptions::validate(const std::string& s) const
 	estimator.validate(s);
 }
 
+namespace
+{
+/** Cosine of the largest angle between the rays of the first observing keyframe and each
+ * other one towards the landmark (1: seen from one place only). */
+double largestParallaxCos(const sfm::SparseMap& map, const sfm::Landmark& lm)
+{
+	double minCos = 1.0;
+	std::optional<Eigen::Vector3d> first;
+	for (const auto& [kf, idx] : lm.observations)
+	{
+		if (!map.hasKeyFrame(kf)) continue;
+		const auto& t = map.keyframe(kf).T_world_cam;
+		const Eigen::Vector3d ray = (lm.p_world - Eigen::Vector3d(t.x(), t.y(), t.z())).normalized();
+		if (!first) first = ray;
+		else
+			minCos = std::min(minCos, first->dot(ray));
+	}
+	return minCos;
+}
+}  // namespace
+
 MetricScale::MetricScale(const MetricScaleOptions& opts) : m_opts(opts), m_estimator(opts.estimator) { opts.validate(); }
 
 std::optional<double> MetricScale::update(sfm::SparseMap& map)
@@ -41,7 +66,9 @@ std::optional<double> MetricScale::update(sfm::SparseMap& map)
 	for (const auto& [id, kf] : map.keyframes()) poses.push_back(kf.T_world_cam);
 	std::vector<Eigen::Vector3d> points;
 	points.reserve(map.numLandmarks());
-	for (const auto& [id, lm] : map.landmarks()) points.push_back(lm.p_world);
+	const double minCos = std::cos(m_opts.minPointParallaxDeg * M_PI / 180.0);
+	for (const auto& [id, lm] : map.landmarks())
+		if (!(largestParallaxCos(map, lm) > minCos)) points.push_back(lm.p_world);
 	const auto r = m_estimator.estimate(poses, points);
 	m_stats.estimates++;
 	m_stats.lastMessage = r.message;

@@ -57,6 +57,19 @@ struct TwoViewOptions
 	/** Ambiguous when the second-best hypothesis has more than this share of the best one's
 	 * good points (Default: 0.75) */
 	double maxSecondBestShare{0.75};
+	/** A competing hypothesis whose median parallax is below min_parallax_deg and below this
+	 * share of the best one's is no rival: it reads the views as nearly a rotation about a far
+	 * scene, which could not start a map. This is the usual false solution of a plane seen
+	 * under sideways motion: the homography's second decomposition puts the plane normal along
+	 * the direction of travel, a plane seen edge-on whose points come out far away. Under
+	 * forward motion both solutions keep comparable parallax and stay ambiguous. The parallax
+	 * of both is compared after the best one's refinement. 0: every hypothesis with enough
+	 * good points is a rival, as ORB-SLAM (Default: 0.5) */
+	double rivalParallaxShare{0.5};
+	/** ... and only when the best hypothesis turns the camera by at most this many times its
+	 * median parallax: a view pair dominated by rotation has small errors of that rotation
+	 * (rolling shutter, calibration) read as parallax (Default: 3) */
+	double rivalMaxRotationRatio{3.0};
 	/** The homography is chosen when R_H = S_H / (S_H + S_F) exceeds this (Default: 0.45, the
 	 * paper; ORB-SLAM2's code uses 0.40) */
 	double homographyRatio{0.45};
@@ -147,7 +160,8 @@ struct TwoViewResult
 	/** Median parallax of the selected hypothesis's good points [deg] */
 	double parallaxDeg{0};
 	int numInliers{0}, numTriangulated{0};
-	/** Good points (cheirality + reprojection) of the best and second-best hypotheses */
+	/** Good points (cheirality + reprojection) of the best hypothesis and of its strongest
+	 * rival (TwoViewOptions::rivalParallaxShare) */
 	int bestGood{0}, secondGood{0};
 	/** Failure Ambiguous: the hypotheses that explain the inliers about equally well, the best
 	 * (refined) first. On a plane the homography's two motions both keep every point in front
