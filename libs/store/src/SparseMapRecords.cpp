@@ -8,8 +8,8 @@ static_assert(kNoLandmark == sfm::kNoLandmark, "the store writes sfm's landmark 
 
 namespace
 {
-/** Calls copy(kfField, recField) for every field a keyframe and its record both hold as it is.
- * One side is const: the direction of the copy. */
+/** Calls copy(kfField, recField) for every field a keyframe and its record both hold as it is,
+ * in the order sfm::KeyFrame declares them. One side is const: the direction of the copy. */
 template <class KeyFrame, class Record, class Copy>
 void forKeyFrameFields(KeyFrame& kf, Record& rec, Copy&& copy)
 {
@@ -17,8 +17,6 @@ void forKeyFrameFields(KeyFrame& kf, Record& rec, Copy&& copy)
 	copy(kf.frameIndex, rec.frameIndex);
 	copy(kf.timestamp, rec.timestamp);
 	copy(kf.T_world_cam, rec.T_world_cam);
-	copy(kf.parent, rec.parent);
-	copy(kf.hasParent, rec.hasParent);
 	copy(kf.features.camera, rec.camera);
 	copy(kf.features.keypoints, rec.keypoints);
 	copy(kf.features.undistorted, rec.undistorted);
@@ -27,6 +25,8 @@ void forKeyFrameFields(KeyFrame& kf, Record& rec, Copy&& copy)
 	copy(kf.features.levelScale, rec.levelScale);
 	copy(kf.features.numLevels, rec.numLevels);
 	copy(kf.landmarks, rec.landmarks);
+	copy(kf.parent, rec.parent);
+	copy(kf.hasParent, rec.hasParent);
 }
 
 /** The same for a landmark and its record. */
