@@ -1,6 +1,6 @@
 #include <keygrid/core/CommandLine.h>
+#include <keygrid/core/TumText.h>
 
-#include <cmath>
 #include <iostream>
 #include <sstream>
 
@@ -119,18 +119,8 @@ std::string CommandLine::get(const std::string& name) const
 double CommandLine::getDouble(const std::string& name) const
 {
 	const std::string v = get(name);
-	std::size_t used = 0;
 	double d = 0;
-	try
-	{
-		d = std::stod(v, &used);
-	}
-	catch (const std::exception&)
-	{
-		used = 0;
-	}
-	if (used != v.size() || v.empty() || !std::isfinite(d))
-		throw CommandLineError("--" + name + " expects a number, got '" + v + "'");
+	if (!parseDouble(v, d)) throw CommandLineError("--" + name + " expects a number, got '" + v + "'");
 	return d;
 }
 

@@ -1,4 +1,5 @@
 #include "LoopCorrection.h"
+#include "LoopVerification.h"
 
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/loop/DataFiles.h>
@@ -289,19 +290,9 @@ bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::Pi
 		pb.push_back(K.backProject(b.features.undistorted[j].x, b.features.undistorted[j].y, db));
 	}
 	rec.matches = static_cast<int>(pa.size());
-	if (static_cast<int>(pa.size()) < m_opts.ransac.minInliers)
-	{
-		rec.outcome = LoopQueryOutcome::FewMatches;
-		return false;
-	}
-	const auto r = estimateRigidTransformRansac(pa, pb, m_opts.ransac);
-	rec.inliers = r.numInliers;
-	if (!r.success)
-	{
-		rec.outcome = LoopQueryOutcome::RansacFailed;
-		return false;
-	}
-	T_cand_cur = r.T_a_b;
+	const auto r = detail::verifiedByRansac(rec, m_opts.ransac.minInliers, [&] { return estimateRigidTransformRansac(pa, pb, m_opts.ransac); });
+	if (!r) return false;
+	T_cand_cur = r->T_a_b;
 	return true;
 }
 

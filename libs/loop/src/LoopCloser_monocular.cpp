@@ -2,6 +2,7 @@
  * as a similarity between the map points of both keyframes, and its correction by a Sim(3) pose
  * graph. Detection, plausibility, map merging and landmark fusion are LoopCloser.cpp's. */
 #include "LoopCorrection.h"
+#include "LoopVerification.h"
 
 #include <keygrid/loop/DirectIndexMatcher.h>
 #include <keygrid/loop/LoopCloser.h>
@@ -76,27 +77,17 @@ bool LoopCloser::verifySim3(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm
 	if (!a.features.isBinary()) mo.maxDistance = m_matcher.maxDistanceSift;
 	const auto matches = landmarkMatches(m_map, a, b, matchByDirectIndex(a.features.descriptors, fa, b.features.descriptors, fb, mo));
 	rec.matches = static_cast<int>(matches.size());
-	if (rec.matches < m_opts.sim3.minInliers)
-	{
-		rec.outcome = LoopQueryOutcome::FewMatches;
-		return false;
-	}
-	const auto r = estimateSim3Ransac(matches, K, m_opts.sim3);
-	rec.inliers = r.numInliers;
-	if (!r.success)
-	{
-		rec.outcome = LoopQueryOutcome::RansacFailed;
-		return false;
-	}
+	const auto r = detail::verifiedByRansac(rec, m_opts.sim3.minInliers, [&] { return estimateSim3Ransac(matches, K, m_opts.sim3); });
+	if (!r) return false;
 	// A few matches can agree by chance; a true loop puts the whole place right: the loop
 	// side's landmarks must land on the current keyframe's keypoints.
-	rec.projectedMatches = countProjectedMatches(cur, cand, r.S_a_b, K);
+	rec.projectedMatches = countProjectedMatches(cur, cand, r->S_a_b, K);
 	if (rec.projectedMatches < m_opts.sim3MinMatches)
 	{
 		rec.outcome = LoopQueryOutcome::ProjectionFailed;
 		return false;
 	}
-	S_cand_cur = r.S_a_b;
+	S_cand_cur = r->S_a_b;
 	return true;
 }
 

@@ -102,35 +102,30 @@ RigidRansacResult estimateRigidTransformRansac(
 	if (n < 3) return res;
 
 	const double thr2 = opts.inlierThreshold * opts.inlierThreshold;
-	std::mt19937_64 rng(opts.seed);
-	std::uniform_int_distribution<std::size_t> pick(0, n - 1);
 	std::vector<char> inl(n);
 	Eigen::Matrix4d best = Eigen::Matrix4d::Identity();
 	int bestCount = -1;
 	double bestSse = 0;
-	int needed = opts.maxIterations;
-	for (int it = 0; it < std::min(needed, opts.maxIterations); ++it)
-	{
-		++res.iterations;
-		std::size_t s[3];
-		detail::drawThreeDistinct(rng, pick, s);
-		// Degenerate samples (collinear or coincident points) do not fix a rotation.
-		const double areaB = (p_b[s[1]] - p_b[s[0]]).cross(p_b[s[2]] - p_b[s[0]]).norm();
-		const double areaA = (p_a[s[1]] - p_a[s[0]]).cross(p_a[s[2]] - p_a[s[0]]).norm();
-		if (areaA < 1e-3 * thr2 || areaB < 1e-3 * thr2) continue;
-		Eigen::Matrix4d T;
-		if (!fit(p_a, p_b, {static_cast<int>(s[0]), static_cast<int>(s[1]), static_cast<int>(s[2])}, opts.estimateScale, T))
-			continue;
-		double sse;
-		const int count = classify(p_a, p_b, T, thr2, inl, sse);
-		if (count > bestCount || (count == bestCount && sse < bestSse))
+	res.iterations = detail::runRansacHypotheses(
+		opts.seed, n, opts.maxIterations, opts.confidence,
+		[&](const std::size_t s[3]) -> std::optional<int>
 		{
+			// Degenerate samples (collinear or coincident points) do not fix a rotation.
+			const double areaB = (p_b[s[1]] - p_b[s[0]]).cross(p_b[s[2]] - p_b[s[0]]).norm();
+			const double areaA = (p_a[s[1]] - p_a[s[0]]).cross(p_a[s[2]] - p_a[s[0]]).norm();
+			if (areaA < 1e-3 * thr2 || areaB < 1e-3 * thr2) return std::nullopt;
+			Eigen::Matrix4d T;
+			if (!fit(p_a, p_b, {static_cast<int>(s[0]), static_cast<int>(s[1]), static_cast<int>(s[2])}, opts.estimateScale, T))
+				return std::nullopt;
+			double sse;
+			const int count = classify(p_a, p_b, T, thr2, inl, sse);
+			const bool better = count > bestCount || (count == bestCount && sse < bestSse);
+			if (!better) return std::nullopt;
 			bestCount = count;
 			bestSse = sse;
 			best = T;
-			needed = detail::ransacIterationsNeeded(count, n, opts.confidence, it, needed);
-		}
-	}
+			return count;
+		});
 	if (bestCount < 3) return res;
 
 	// Refinement: least-squares fit on all inliers, re-classify, until the set stops changing.

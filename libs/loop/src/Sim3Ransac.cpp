@@ -144,25 +144,21 @@ Sim3RansacResult estimateSim3Ransac(const std::vector<Sim3Match>& ms, const core
 	res.inlier.assign(n, 0);
 	if (n < 3) return res;
 
-	std::mt19937_64 rng(opts.seed);
-	std::uniform_int_distribution<std::size_t> pick(0, n - 1);
 	std::vector<char> inl(n);
 	Sim3 best;
 	int bestCount = 0;
-	int needed = opts.maxIterations;
-	for (int it = 0; it < std::min(needed, opts.maxIterations); ++it)
-	{
-		++res.iterations;
-		std::size_t s[3];
-		detail::drawThreeDistinct(rng, pick, s);
-		Sim3 S;
-		if (!fitMinimal(ms, s, S)) continue;
-		const int count = classify(ms, S, K, opts.inlierChi2, inl);
-		if (count <= bestCount) continue;
-		bestCount = count;
-		best = S;
-		needed = detail::ransacIterationsNeeded(count, n, opts.confidence, it, needed);
-	}
+	res.iterations = detail::runRansacHypotheses(
+		opts.seed, n, opts.maxIterations, opts.confidence,
+		[&](const std::size_t s[3]) -> std::optional<int>
+		{
+			Sim3 S;
+			if (!fitMinimal(ms, s, S)) return std::nullopt;
+			const int count = classify(ms, S, K, opts.inlierChi2, inl);
+			if (count <= bestCount) return std::nullopt;
+			bestCount = count;
+			best = S;
+			return count;
+		});
 	if (bestCount < 3) return res;
 
 	// Refinement by reprojection on the inliers, re-classified after each round.

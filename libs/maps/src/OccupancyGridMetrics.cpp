@@ -17,11 +17,7 @@ FloorPlanGrid FloorPlanGrid::fromOccupancy(
 			"FloorPlanGrid::fromOccupancy: " + std::to_string(occupied.size()) + " cells for a " + std::to_string(sizeX) +
 			" x " + std::to_string(sizeY) + " lattice");
 	FloorPlanGrid g;
-	g.resolution = resolution;
-	g.xMin = xMin;
-	g.yMin = yMin;
-	g.sizeX = sizeX;
-	g.sizeY = sizeY;
+	static_cast<GridLattice&>(g) = GridLattice{resolution, xMin, yMin, sizeX, sizeY};
 	g.cells.resize(occupied.size());
 	for (std::size_t i = 0; i < occupied.size(); i++) g.cells[i] = occupied[i] ? Occupied : Free;
 	return g;
@@ -40,14 +36,14 @@ bool FloorPlanGrid::inView(int cx, int cy) const
 	const Cell c = cell(cx, cy);
 	if (c == Ignore) return false;
 	const uint8_t bit = c == Occupied ? SeenSurface : SeenFreeSpace;
-	return (seen[static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX] & bit) != 0;
+	return (seen[cellIndex(cx, cy)] & bit) != 0;
 }
 
 bool FloorPlanGrid::floorInView(int cx, int cy) const
 {
 	if (seen.empty()) return true;
 	if (cell(cx, cy) == Ignore) return false;
-	return (seen[static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX] & SeenFloor) != 0;
+	return (seen[cellIndex(cx, cy)] & SeenFloor) != 0;
 }
 
 bool OccupancyMetricsOptions::isValid(std::string* error) const
@@ -292,10 +288,10 @@ std::vector<CellVerdict> classifyCells(const TriStateGrid& est, const FloorPlanG
 {
 	const EstView view = viewOf(est);
 	const Scorer sc(view, gt, opts);
-	std::vector<CellVerdict> v(static_cast<size_t>(gt.sizeX) * static_cast<size_t>(gt.sizeY));
+	std::vector<CellVerdict> v(gt.numCells());
 	for (int cy = 0; cy < gt.sizeY; cy++)
 		for (int cx = 0; cx < gt.sizeX; cx++)
-			v[static_cast<size_t>(cx) + static_cast<size_t>(cy) * gt.sizeX] = sc.verdict(cx, cy);
+			v[gt.cellIndex(cx, cy)] = sc.verdict(cx, cy);
 	return v;
 }
 
@@ -307,10 +303,10 @@ TriStateGrid TriStateGrid::fromGrid(const CISMOccupancyGrid2D& g)
 	t.yMin = g.yMin();
 	t.sizeX = g.sizeX();
 	t.sizeY = g.sizeY();
-	t.cells.resize(static_cast<size_t>(t.sizeX) * static_cast<size_t>(t.sizeY));
+	t.cells.resize(t.numCells());
 	for (int cy = 0; cy < t.sizeY; cy++)
 		for (int cx = 0; cx < t.sizeX; cx++)
-			t.cells[static_cast<size_t>(cx) + static_cast<size_t>(cy) * t.sizeX] = g.cellState(cx, cy);
+			t.cells[t.cellIndex(cx, cy)] = g.cellState(cx, cy);
 	return t;
 }
 
@@ -368,7 +364,7 @@ TriStateGrid TriStateGrid::loadRosMapServer(const std::string& yamlPath)
 	t.sizeY = std::stoi(token());
 	if (std::stoi(token()) != 255) throw std::runtime_error("'" + pgmPath + "': maxval must be 255");
 	pgm.get();  // the single whitespace after maxval
-	std::vector<unsigned char> img(static_cast<size_t>(t.sizeX) * static_cast<size_t>(t.sizeY));
+	std::vector<unsigned char> img(t.numCells());
 	pgm.read(reinterpret_cast<char*>(img.data()), static_cast<std::streamsize>(img.size()));
 	if (!pgm) throw std::runtime_error("'" + pgmPath + "': truncated pixel data");
 	t.cells.resize(img.size());
@@ -378,7 +374,7 @@ TriStateGrid TriStateGrid::loadRosMapServer(const std::string& yamlPath)
 		for (int cx = 0; cx < t.sizeX; cx++)
 		{
 			const unsigned char v = img[static_cast<size_t>(r) * t.sizeX + cx];
-			t.cells[static_cast<size_t>(cx) + static_cast<size_t>(cy) * t.sizeX] =
+			t.cells[t.cellIndex(cx, cy)] =
 				v == 0 ? CellState::Occupied : v == 254 ? CellState::Free : CellState::Unknown;
 		}
 	}
@@ -386,23 +382,18 @@ TriStateGrid TriStateGrid::loadRosMapServer(const std::string& yamlPath)
 }
 
 TriStateGrid resampleTriState(
-	const TriStateGrid& src, const mrpt::poses::CPose3D& T_B_A, const TriStateGrid& like)
+	const TriStateGrid& src, const mrpt::poses::CPose3D& T_B_A, const GridLattice& lattice)
 {
 	TriStateGrid out;
-	out.resolution = like.resolution;
-	out.xMin = like.xMin;
-	out.yMin = like.yMin;
-	out.sizeX = like.sizeX;
-	out.sizeY = like.sizeY;
-	out.T_world_floor = like.T_world_floor;
-	out.cells.assign(static_cast<size_t>(out.sizeX) * static_cast<size_t>(out.sizeY), CellState::Unknown);
+	static_cast<GridLattice&>(out) = lattice;
+	out.cells.assign(out.numCells(), CellState::Unknown);
 	const mrpt::poses::CPose3D T_A_B = -T_B_A;
 	for (int cy = 0; cy < out.sizeY; cy++)
 		for (int cx = 0; cx < out.sizeX; cx++)
 		{
 			double ax, ay, az;
 			T_A_B.composePoint(out.xMin + (cx + 0.5) * out.resolution, out.yMin + (cy + 0.5) * out.resolution, 0.0, ax, ay, az);
-			out.cells[static_cast<size_t>(cx) + static_cast<size_t>(cy) * out.sizeX] = src.at(ax, ay);
+			out.cells[out.cellIndex(cx, cy)] = src.at(ax, ay);
 		}
 	return out;
 }

@@ -73,21 +73,31 @@ core::OptionFields SlamConfig::fields()
 	return f;
 }
 
+namespace
+{
+/** The options struct of every section after [slam], with its section name. */
+template <class Config, class Visit>
+void forEachSection(Config& cfg, Visit&& visit)
+{
+	visit(cfg.features, "features");
+	visit(cfg.tracker, "tracker");
+	visit(cfg.tracker.hoc, "hoc");
+	visit(cfg.tracker.mono, "monocular");
+	visit(cfg.mapping, "mapping");
+	visit(cfg.refinement, "refinement");
+	visit(cfg.maps, "maps");
+	visit(cfg.floor, "floor");
+	visit(cfg.loop, "loop_closing");
+	visit(cfg.store, "store");
+	visit(cfg.metricScale, "camera_height_scale");
+}
+}  // namespace
+
 void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 {
 	fields().read(c, "slam");
 	core::validateFields(*this, "slam");
-	features.loadFromConfigFile(c, "features");
-	tracker.loadFromConfigFile(c, "tracker");
-	tracker.hoc.loadFromConfigFile(c, "hoc");
-	tracker.mono.loadFromConfigFile(c, "monocular");
-	mapping.loadFromConfigFile(c, "mapping");
-	refinement.loadFromConfigFile(c, "refinement");
-	maps.loadFromConfigFile(c, "maps");
-	floor.loadFromConfigFile(c, "floor");
-	loop.loadFromConfigFile(c, "loop_closing");
-	store.loadFromConfigFile(c, "store");
-	metricScale.loadFromConfigFile(c, "camera_height_scale");
+	forEachSection(*this, [&c](auto& options, const char* section) { options.loadFromConfigFile(c, section); });
 	// The depth residual model is shared by tracking and bundle adjustment.
 	mapping.ba.bf = tracker.pose.bf;
 	mapping.ba.disparitySigma = tracker.pose.disparitySigma;
@@ -100,17 +110,7 @@ void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 void SlamConfig::saveToConfigFile(mrpt::config::CConfigFileBase& c) const
 {
 	core::writeFields(*this, c, "slam");
-	features.saveToConfigFile(c, "features");
-	tracker.saveToConfigFile(c, "tracker");
-	tracker.hoc.saveToConfigFile(c, "hoc");
-	tracker.mono.saveToConfigFile(c, "monocular");
-	mapping.saveToConfigFile(c, "mapping");
-	refinement.saveToConfigFile(c, "refinement");
-	maps.saveToConfigFile(c, "maps");
-	floor.saveToConfigFile(c, "floor");
-	loop.saveToConfigFile(c, "loop_closing");
-	store.saveToConfigFile(c, "store");
-	metricScale.saveToConfigFile(c, "camera_height_scale");
+	forEachSection(*this, [&c](const auto& options, const char* section) { options.saveToConfigFile(c, section); });
 }
 
 namespace

@@ -179,28 +179,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	if (m_metricScale && tf.newKeyFrame) applyMetricScale(tf);
 	tf.mapLandmarks = m_map.numLandmarks();
 	lock.unlock();
-	{
-		std::lock_guard<std::mutex> lk(m_statsMutex);
-		m_stats.landmarksPrunedHoc += tf.hoc.pruned;
-		m_stats.hocIncrements += tf.hoc.incremented;
-		m_stats.hocDecrements += tf.hoc.decremented;
-		m_stats.hocOccluded += tf.hoc.occluded;
-		m_stats.hocRecovered += tf.hoc.recovered;
-		m_stats.hocSeenThrough += tf.hoc.seenThrough;
-		if (tf.hocFallback) m_stats.hocFallbackFrames++;
-		m_stats.frames++;
-		m_stats.sumInliers += tf.inliers;
-		if (tf.tracked) m_stats.tracked++;
-		else
-			m_stats.lost++;
-		if (tf.method == sfm::TrackingMethod::Relocalization && tf.tracked) m_stats.relocalizations++;
-		if (tf.method == sfm::TrackingMethod::Pnp && tf.tracked) m_stats.pnpFallbacks++;
-		if (tf.hasInitialKeyFrame)
-		{
-			m_stats.framesToInitialize = m_stats.frames;
-			m_stats.initializationFrame = tf.index;
-		}
-	}
+	countFrame(tf);
 	const bool queueKeyFrame = tf.newKeyFrame && m_mappingQueue;
 	m_frames.push_back(std::move(tf));
 	if (queueKeyFrame && initialJob)
@@ -215,6 +194,30 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		waitForMapping();
 	}
 	return m_frames.back();
+}
+
+void System::countFrame(const sfm::TrackedFrame& tf)
+{
+	std::lock_guard<std::mutex> lk(m_statsMutex);
+	m_stats.landmarksPrunedHoc += tf.hoc.pruned;
+	m_stats.hocIncrements += tf.hoc.incremented;
+	m_stats.hocDecrements += tf.hoc.decremented;
+	m_stats.hocOccluded += tf.hoc.occluded;
+	m_stats.hocRecovered += tf.hoc.recovered;
+	m_stats.hocSeenThrough += tf.hoc.seenThrough;
+	if (tf.hocFallback) m_stats.hocFallbackFrames++;
+	m_stats.frames++;
+	m_stats.sumInliers += tf.inliers;
+	if (tf.tracked) m_stats.tracked++;
+	else
+		m_stats.lost++;
+	if (tf.method == sfm::TrackingMethod::Relocalization && tf.tracked) m_stats.relocalizations++;
+	if (tf.method == sfm::TrackingMethod::Pnp && tf.tracked) m_stats.pnpFallbacks++;
+	if (tf.hasInitialKeyFrame)
+	{
+		m_stats.framesToInitialize = m_stats.frames;
+		m_stats.initializationFrame = tf.index;
+	}
 }
 
 void System::logInitialization(const sfm::TrackedFrame& tf)

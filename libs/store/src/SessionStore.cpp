@@ -2,6 +2,7 @@
  * Creating and opening session files: schema, pragmas, the checks Open() makes, meta table,
  * cameras. Writing: SessionStore_write.cpp; reading: SessionStore_read.cpp.
  */
+#include <keygrid/core/TumText.h>
 #include <keygrid/store/SessionStore.h>
 
 #include <chrono>
@@ -75,19 +76,10 @@ std::string exactText(double v)
 	return buf;
 }
 
-double parseDouble(const std::string& s, const std::string& key, const std::string& path)
+double metaNumber(const std::string& s, const std::string& key, const std::string& path)
 {
-	std::size_t used = 0;
 	double v = 0;
-	try
-	{
-		v = std::stod(s, &used);
-	}
-	catch (const std::exception&)
-	{
-		used = 0;
-	}
-	if (used == 0 || used != s.size())
+	if (!core::parseDouble(s, v))
 		throw std::runtime_error("'" + path + "': meta key '" + key + "' is not a number: '" + s + "'");
 	return v;
 }
@@ -279,7 +271,7 @@ void SessionStore::Impl::loadMeta()
 		if (it == kv.end()) throw std::runtime_error("'" + path + "' is damaged: meta key '" + key + "' is missing");
 		return it->second;
 	};
-	const auto num = [&](const std::string& key) { return parseDouble(get(key), key, path); };
+	const auto num = [&](const std::string& key) { return metaNumber(get(key), key, path); };
 	if (get("format") != kFormatName)
 		throw std::runtime_error("'" + path + "' is not a keygrid session (meta format '" + get("format") + "')");
 	meta.schemaVersion = static_cast<int>(num("schema_version"));

@@ -6,23 +6,55 @@ namespace keygrid::store
 {
 static_assert(kNoLandmark == sfm::kNoLandmark, "the store writes sfm's landmark ids unchanged");
 
+namespace
+{
+/** Calls copy(kfField, recField) for every field a keyframe and its record both hold as it is,
+ * in the order sfm::KeyFrame declares them. One side is const: the direction of the copy. */
+template <class KeyFrame, class Record, class Copy>
+void forKeyFrameFields(KeyFrame& kf, Record& rec, Copy&& copy)
+{
+	copy(kf.id, rec.id);
+	copy(kf.frameIndex, rec.frameIndex);
+	copy(kf.timestamp, rec.timestamp);
+	copy(kf.T_world_cam, rec.T_world_cam);
+	copy(kf.features.camera, rec.camera);
+	copy(kf.features.keypoints, rec.keypoints);
+	copy(kf.features.undistorted, rec.undistorted);
+	copy(kf.features.depth, rec.keypointDepth);
+	copy(kf.features.descriptors, rec.descriptors);
+	copy(kf.features.levelScale, rec.levelScale);
+	copy(kf.features.numLevels, rec.numLevels);
+	copy(kf.landmarks, rec.landmarks);
+	copy(kf.parent, rec.parent);
+	copy(kf.hasParent, rec.hasParent);
+}
+
+/** The same for a landmark and its record. */
+template <class Landmark, class Record, class Copy>
+void forLandmarkFields(Landmark& lm, Record& rec, Copy&& copy)
+{
+	copy(lm.id, rec.id);
+	copy(lm.p_world, rec.p_world);
+	copy(lm.descriptor, rec.descriptor);
+	copy(lm.observations, rec.observations);
+	copy(lm.normal, rec.normal);
+	copy(lm.minDistance, rec.minDistance);
+	copy(lm.maxDistance, rec.maxDistance);
+	copy(lm.firstKeyFrame, rec.firstKeyFrame);
+	copy(lm.visibleCount, rec.visibleCount);
+	copy(lm.foundCount, rec.foundCount);
+}
+
+/** copy() of the for*Fields tables from the frontend's object into the record ... */
+const auto intoRecord = [](const auto& object, auto& record) { record = object; };
+/** ... and from the record into the object. */
+const auto fromRecord = [](auto& object, const auto& record) { object = record; };
+}  // namespace
+
 KeyFrameRecord toRecord(const sfm::KeyFrame& kf, const loop::BowVector& bow)
 {
 	KeyFrameRecord r;
-	r.id = kf.id;
-	r.frameIndex = kf.frameIndex;
-	r.timestamp = kf.timestamp;
-	r.T_world_cam = kf.T_world_cam;
-	r.parent = kf.parent;
-	r.hasParent = kf.hasParent;
-	r.camera = kf.features.camera;
-	r.keypoints = kf.features.keypoints;
-	r.undistorted = kf.features.undistorted;
-	r.keypointDepth = kf.features.depth;
-	r.descriptors = kf.features.descriptors;
-	r.levelScale = kf.features.levelScale;
-	r.numLevels = kf.features.numLevels;
-	r.landmarks = kf.landmarks;
+	forKeyFrameFields(kf, r, intoRecord);
 	r.bow = bow;
 	return r;
 }
@@ -30,21 +62,8 @@ KeyFrameRecord toRecord(const sfm::KeyFrame& kf, const loop::BowVector& bow)
 sfm::KeyFrame toKeyFrame(const KeyFrameRecord& rec)
 {
 	sfm::KeyFrame kf;
-	kf.id = rec.id;
-	kf.frameIndex = static_cast<std::size_t>(rec.frameIndex);
-	kf.timestamp = rec.timestamp;
-	kf.T_world_cam = rec.T_world_cam;
-	kf.parent = rec.parent;
-	kf.hasParent = rec.hasParent;
-	kf.features.camera = rec.camera;
-	kf.features.keypoints = rec.keypoints;
-	kf.features.undistorted = rec.undistorted;
-	kf.features.depth = rec.keypointDepth;
-	kf.features.descriptors = rec.descriptors;
-	kf.features.levelScale = rec.levelScale;
-	kf.features.numLevels = rec.numLevels;
+	forKeyFrameFields(kf, rec, fromRecord);
 	kf.features.buildGrid();
-	kf.landmarks = rec.landmarks;
 	return kf;
 }
 
@@ -56,16 +75,7 @@ EncodedImages encodeImages(const sfm::KeyFrame& kf, const KeyFrameImageCodec& co
 LandmarkRecord toRecord(const sfm::Landmark& lm)
 {
 	LandmarkRecord r;
-	r.id = lm.id;
-	r.p_world = lm.p_world;
-	r.descriptor = lm.descriptor;
-	r.observations = lm.observations;
-	r.normal = lm.normal;
-	r.minDistance = lm.minDistance;
-	r.maxDistance = lm.maxDistance;
-	r.firstKeyFrame = lm.firstKeyFrame;
-	r.visibleCount = lm.visibleCount;
-	r.foundCount = lm.foundCount;
+	forLandmarkFields(lm, r, intoRecord);
 	r.hocCounts = lm.hoc.counts();
 	return r;
 }
@@ -73,16 +83,7 @@ LandmarkRecord toRecord(const sfm::Landmark& lm)
 sfm::Landmark toLandmark(const LandmarkRecord& rec)
 {
 	sfm::Landmark lm;
-	lm.id = rec.id;
-	lm.p_world = rec.p_world;
-	lm.descriptor = rec.descriptor;
-	lm.observations = rec.observations;
-	lm.normal = rec.normal;
-	lm.minDistance = rec.minDistance;
-	lm.maxDistance = rec.maxDistance;
-	lm.firstKeyFrame = rec.firstKeyFrame;
-	lm.visibleCount = rec.visibleCount;
-	lm.foundCount = rec.foundCount;
+	forLandmarkFields(lm, rec, fromRecord);
 	lm.hoc.setCounts(rec.hocCounts);
 	return lm;
 }

@@ -180,13 +180,7 @@ int main(int argc, char** argv)
 			const double tiltDeg = std::acos(std::min(1.0, std::abs(R(2, 2)))) * 180.0 / M_PI;
 			std::printf("estimated floor in the sim world: origin (%.3f, %.3f, %.3f) m, yaw %.2f deg, tilt %.2f deg\n",
 				T_sim_floor.x(), T_sim_floor.y(), T_sim_floor.z(), T_sim_floor.yaw() * 180.0 / M_PI, tiltDeg);
-			maps::TriStateGrid like;
-			like.resolution = gt.resolution;
-			like.xMin = gt.xMin;
-			like.yMin = gt.yMin;
-			like.sizeX = gt.sizeX;
-			like.sizeY = gt.sizeY;
-			const auto res = maps::resampleTriState(est, T_sim_floor, like);
+			const auto res = maps::resampleTriState(est, T_sim_floor, gt);
 			printMetrics("slam map_2d (" + a.slamMap + ")", maps::evaluateOccupancy(res, gt, tol),
 				maps::evaluateOccupancy(res, gt, exact));
 			return 0;

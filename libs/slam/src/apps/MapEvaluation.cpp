@@ -89,13 +89,7 @@ MapEvaluationResult evaluateMapAgainstFloorPlan(
 	const auto R = T_gt_floor.getRotationMatrix();
 	r.floorTiltDeg = std::acos(std::min(1.0, std::abs(R(2, 2)))) * 180.0 / M_PI;
 
-	maps::TriStateGrid like;
-	like.resolution = gt.resolution;
-	like.xMin = gt.xMin;
-	like.yMin = gt.yMin;
-	like.sizeX = gt.sizeX;
-	like.sizeY = gt.sizeY;
-	const maps::TriStateGrid onPlan = maps::resampleTriState(est, T_gt_floor, like);
+	const maps::TriStateGrid onPlan = maps::resampleTriState(est, T_gt_floor, gt);
 
 	if (!o.scenePath.empty()) r.visibilityKeyframes = markVisibility(gt, o, gtTraj);
 	r.metrics = maps::evaluateOccupancy(onPlan, gt, o.metrics);

@@ -96,19 +96,12 @@ std::optional<Json> session(const System& sys, const SlamReportInput& in)
 	}
 	return s;
 }
-}  // namespace
 
-std::string slamReportJson(const System& sys, const SlamReportInput& in)
+/** What gives the map its scale and, monocular, how the map started. */
+void addScale(Json& js, const System& sys, const SlamConfig& cfg)
 {
 	const auto st = sys.stats();
-	const auto& cfg = in.config;
-	Json js;
-	js["input"] = in.input;
-	js["config"] = in.options.configPath;
-	js["config_set"] = in.options.set.empty() ? Json() : Json(in.options.set);
-	js["mode"] = toString(cfg.mode);
-	js["sensor"] = toString(cfg.sensor);
-	// What gives the map its scale: measured depth, or nothing (monocular: arbitrary units).
+	// Measured depth, or nothing (monocular: arbitrary units).
 	const MetricScale* ms = sys.metricScale();
 	js["scale_source"] = cfg.sensor == Sensor::Rgbd ? "depth" : ms && ms->metric() ? "camera_height" : "none";
 	if (ms)
@@ -122,6 +115,12 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 		js["initialization"] = {{"started", st.framesToInitialize > 0},
 								{"frames", st.framesToInitialize > 0 ? Json(st.framesToInitialize) : Json()},
 								{"frame", st.framesToInitialize > 0 ? Json(st.initializationFrame) : Json()}};
+}
+
+/** How the frames went: tracked, lost, relocalized; what the input skipped or dropped. */
+void addTracking(Json& js, const System& sys, const SlamReportInput& in)
+{
+	const auto st = sys.stats();
 	js["frames"] = st.frames;
 	js["tracked"] = st.tracked;
 	js["lost"] = st.lost;
@@ -132,14 +131,20 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	if (!in.result.lastSkip.empty()) js["last_skip_reason"] = in.result.lastSkip;
 	js["interrupted"] = in.result.interrupted;
 	if (in.live) js["live"] = {{"grabbed", in.result.liveGrabbed}, {"dropped", in.result.liveDropped}};
+}
+
+/** The sparse map's size and upkeep (culling, fusion, HOC), loops, session and metric maps. */
+void addMap(Json& js, const System& sys, const SlamReportInput& in)
+{
+	const auto st = sys.stats();
 	js["keyframes"] = sys.map().numKeyFrames();
 	js["keyframes_created"] = st.keyframesCreated;
 	js["keyframes_culled"] = st.keyframesCulled;
 	js["landmarks"] = sys.map().numLandmarks();
 	js["landmarks_culled"] = st.landmarksCulled;
 	js["landmarks_fused"] = st.landmarksFused;
-	if (cfg.mode == RunMode::Threaded) js["ba_discarded"] = st.baDiscarded;
-	if (cfg.tracker.hoc.enabled)
+	if (in.config.mode == RunMode::Threaded) js["ba_discarded"] = st.baDiscarded;
+	if (in.config.tracker.hoc.enabled)
 		js["hoc"] = {{"landmarks_pruned", st.landmarksPrunedHoc}, {"increments", st.hocIncrements}, {"decrements", st.hocDecrements},
 					 {"occluded", st.hocOccluded},		{"recovered", st.hocRecovered},	   {"seen_through", st.hocSeenThrough},
 					 {"fallback_frames", st.hocFallbackFrames}};
@@ -148,6 +153,12 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	if (auto s = session(sys, in)) js["session"] = std::move(*s);
 	js["maps"] = sys.metricMaps() ? parsed(sys.metricMaps()->summaryJson()) : Json::array();
 	js["floor"] = sys.metricMaps() ? parsed(sys.metricMaps()->floorJson()) : Json();
+}
+
+/** Means per frame and per keyframe (bundle adjustment), the final refinement. */
+void addOptimization(Json& js, const System& sys)
+{
+	const auto st = sys.stats();
 	const double kfs = static_cast<double>(std::max<std::size_t>(1, st.keyframesCreated));
 	js["mean_inliers"] = rounded(st.sumInliers / static_cast<double>(std::max<std::size_t>(1, st.frames)), 1);
 	js["mean_ba_keyframes"] = rounded(st.sumBaKeyFrames / kfs, 1);
@@ -159,31 +170,55 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 						   {"outliers", ba->outliersRemoved}, {"iterations", ba->iterations}, {"median_chi2", rounded(ba->medianChi2, 4)}};
 	if (const auto& shift = sys.finalMapShift())
 		js["final_map_shift"] = {{"largest_m", rounded(shift->largest, 5)}, {"reanchored", shift->reanchored}};
+}
+
+/** Speed, timings, memory, and how the per-frame cost evolves along the run. */
+void addCost(Json& js, const System& sys, const SlamReportInput& in)
+{
 	js["fps"] = rounded(in.result.fps, 3);
 	js["wall_time_s"] = rounded(in.wallSeconds, 3);
 	js["timings"] = parsed(sys.timings().toJson(2));
-	// Memory, and how the per-frame cost evolves along the run (tests/benchmarks/slam/office_loop_memory.sh).
+	// tests/benchmarks/slam/office_loop_memory.sh reads the memory growth.
 	js["max_rss_mb"] = rounded(peakResidentMegabytes(), 1);
 	js["rss_mb_by_keyframes"] = parsed(in.memory.toJson());
 	Json blocks = Json::array();
 	for (const double b : sys.timings().blockMeans("track_and_map", 100)) blocks.push_back(rounded(1e3 * b, 2));
 	js["track_and_map_ms_per_100_frames"] = blocks;
-	if (in.errors)
+}
+
+/** --gt: the trajectory's errors against ground truth. */
+void addErrors(Json& js, const System& sys, const eval::TrajectoryErrors& e)
+{
+	// A map without metric scale (monocular): after a Sim(3) alignment, whose scale (metres
+	// per map unit) is recorded.
+	const bool sim3 = !sys.metricUnits();
+	js["ate_alignment"] = sim3 ? "sim3" : "se3";
+	if (sim3) js["ate_sim3_scale"] = e.alignment.s;
+	js["ate_rmse_m"] = e.ate.rmse;
+	js["ate_rot_rmse_deg"] = e.ateRotDeg.rmse;
+	if (e.rpeTrans)
 	{
-		// A map without metric scale (monocular): after a Sim(3) alignment, whose scale (metres
-		// per map unit) is recorded.
-		const bool sim3 = !sys.metricUnits();
-		js["ate_alignment"] = sim3 ? "sim3" : "se3";
-		if (sim3) js["ate_sim3_scale"] = in.errors->alignment.s;
-		js["ate_rmse_m"] = in.errors->ate.rmse;
-		js["ate_rot_rmse_deg"] = in.errors->ateRotDeg.rmse;
-		if (in.errors->rpeTrans)
-		{
-			js["rpe_trans_m_per_s"] = in.errors->rpeTrans->rmse;
-			js["rpe_rot_deg_per_s"] = in.errors->rpeRotDeg->rmse;
-		}
-		js["gt_matched"] = in.errors->matched;
+		js["rpe_trans_m_per_s"] = e.rpeTrans->rmse;
+		js["rpe_rot_deg_per_s"] = e.rpeRotDeg->rmse;
 	}
+	js["gt_matched"] = e.matched;
+}
+}  // namespace
+
+std::string slamReportJson(const System& sys, const SlamReportInput& in)
+{
+	Json js;
+	js["input"] = in.input;
+	js["config"] = in.options.configPath;
+	js["config_set"] = in.options.set.empty() ? Json() : Json(in.options.set);
+	js["mode"] = toString(in.config.mode);
+	js["sensor"] = toString(in.config.sensor);
+	addScale(js, sys, in.config);
+	addTracking(js, sys, in);
+	addMap(js, sys, in);
+	addOptimization(js, sys);
+	addCost(js, sys, in);
+	if (in.errors) addErrors(js, sys, *in.errors);
 	js["output_errors"] = in.outputErrors;
 	js["error"] = in.result.error.empty() ? Json() : Json(in.result.error);
 	// Invalid UTF-8 (a damaged file's bytes quoted in an error) is replaced, not thrown.

@@ -24,8 +24,22 @@
 
 namespace keygrid::maps
 {
+/** A lattice of square cells in a floor frame: cell (cx, cy) covers [xMin + cx res,
+ * xMin + (cx+1) res) x [yMin + cy res, yMin + (cy+1) res); a grid on it stores its cells
+ * row-major, index cx + cy * sizeX. */
+struct GridLattice
+{
+	double resolution{0.05};
+	double xMin{0}, yMin{0};
+	int sizeX{0}, sizeY{0};
+
+	bool contains(int cx, int cy) const { return cx >= 0 && cy >= 0 && cx < sizeX && cy < sizeY; }
+	size_t cellIndex(int cx, int cy) const { return static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX; }
+	size_t numCells() const { return static_cast<size_t>(sizeX) * static_cast<size_t>(sizeY); }
+};
+
 /** A ground-truth floor plan on its own lattice, in the grid's floor frame. */
-struct FloorPlanGrid
+struct FloorPlanGrid : GridLattice
 {
 	enum Cell : uint8_t
 	{
@@ -43,9 +57,6 @@ struct FloorPlanGrid
 		 * ever missing a low obstacle */
 		SeenFloor = 4
 	};
-	double resolution{0.05};
-	double xMin{0}, yMin{0};
-	int sizeX{0}, sizeY{0};
 	std::vector<uint8_t> cells;  ///< row-major, index cx + cy * sizeX
 	/** Optional visibility mask on the same lattice (SeenBits; markSeenCells() fills it). Empty =
 	 * no mask: every cell counts as in view. An Occupied cell is in view with SeenSurface, a
@@ -62,8 +73,8 @@ struct FloorPlanGrid
 	Cell at(double x, double y) const;
 	Cell cell(int cx, int cy) const
 	{
-		if (cx < 0 || cy < 0 || cx >= sizeX || cy >= sizeY) return Ignore;
-		return static_cast<Cell>(cells[static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX]);
+		if (!contains(cx, cy)) return Ignore;
+		return static_cast<Cell>(cells[cellIndex(cx, cy)]);
 	}
 	/** Whether the cameras saw cell (cx, cy) in the sense of its class (true without a mask). */
 	bool inView(int cx, int cy) const;
@@ -148,12 +159,9 @@ constexpr int kCellVerdictCount = 8;
 const char* cellVerdictName(CellVerdict v);
 
 /** A tri-state grid on its own lattice (e.g. a map_2d.pgm re-read, or a grid resampled into
- * the ground truth's frame). Cell (cx, cy) covers [xMin + cx res, xMin + (cx+1) res) x ... */
-struct TriStateGrid
+ * the ground truth's frame). */
+struct TriStateGrid : GridLattice
 {
-	double resolution{0.05};
-	double xMin{0}, yMin{0};
-	int sizeX{0}, sizeY{0};
 	std::vector<CellState> cells;  ///< row-major, index cx + cy * sizeX
 	/** Pose of the grid's floor frame in the world, when the file says so (keygrid's
 	 * saveAsRosMapServer writes it as a comment line). */
@@ -162,8 +170,8 @@ struct TriStateGrid
 	/** Unknown outside the lattice. */
 	CellState cell(int cx, int cy) const
 	{
-		if (cx < 0 || cy < 0 || cx >= sizeX || cy >= sizeY) return CellState::Unknown;
-		return cells[static_cast<size_t>(cx) + static_cast<size_t>(cy) * sizeX];
+		if (!contains(cx, cy)) return CellState::Unknown;
+		return cells[cellIndex(cx, cy)];
 	}
 	CellState at(double x, double y) const
 	{
@@ -240,11 +248,12 @@ void markSeenCells(
 	FloorPlanGrid& gt, const cv::Mat& depth, const core::RgbdCamera& cam,
 	const mrpt::poses::CPose3D& T_floor_cam, const FloorPlanVisibilityOptions& opts = {});
 
-/** Resamples `src` (a grid in floor frame A) onto the lattice of `like` in floor frame B:
- * each output cell takes the state of the source cell under its centre (nearest neighbour),
- * the centre (x, y, 0)_B mapped into A by inv(T_B_A) and its A-height dropped (a small tilt
- * between the two floors is ignored; the caller should report it). */
+/** Resamples `src` (a grid in floor frame A) onto `lattice` in floor frame B (e.g. a ground
+ * truth's): each output cell takes the state of the source cell under its centre (nearest
+ * neighbour), the centre (x, y, 0)_B mapped into A by inv(T_B_A) and its A-height dropped (a
+ * small tilt between the two floors is ignored; the caller should report it). The result has
+ * no T_world_floor. */
 TriStateGrid resampleTriState(
-	const TriStateGrid& src, const mrpt::poses::CPose3D& T_B_A, const TriStateGrid& like);
+	const TriStateGrid& src, const mrpt::poses::CPose3D& T_B_A, const GridLattice& lattice);
 
 }  // namespace keygrid::maps

@@ -191,6 +191,8 @@ class System
 	bool mapKeyFrameConcurrently(const KeyFrameJob& job);
 	/** The counters and timings of one keyframe's local mapping. */
 	void recordLocalMapping(const sfm::LocalMappingReport& rep, double seconds);
+	/** A tracked frame's counts (tracking outcome, HOC updates, initialization) into m_stats. */
+	void countFrame(const sfm::TrackedFrame& tf);
 	/** Monocular: a tracker's initialization message into m_initLog, at a bounded rate. */
 	void logInitialization(const sfm::TrackedFrame& tf);
 	/** Monocular with camera_height, after a new keyframe (map lock held): the map rescaled
