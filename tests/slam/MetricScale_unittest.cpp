@@ -203,6 +203,22 @@ TEST(MetricScale, PointsSeenOverAShortBaselineAreLeftOutOfTheFloorSearch)
 	}
 }
 
+// A map whose points were all seen over a short baseline: the well-triangulated points are too
+// few, and the estimate comes from every point.
+TEST(MetricScale, FallsBackOnEveryPointWhenTheWellTriangulatedOnesGiveNoEstimate)
+{
+	sfm::SparseMap map;
+	const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2500)).id;
+	CPose3D near = circlePose(0, kHeightMap);
+	near.x_incr(0.001);
+	addRoom(map, first, map.addKeyFrame(keyFrame(near, 2500)).id);
+	for (int k = 1; k < 12; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
+	slam::MetricScale scale(options());
+	const auto s = scale.update(map);
+	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+	EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
+}
+
 TEST(MetricScale, NeedsACameraHeightAndValidOptions)
 {
 	EXPECT_THROW(slam::MetricScale(slam::MetricScaleOptions()), std::invalid_argument);

@@ -64,12 +64,19 @@ std::optional<double> MetricScale::update(sfm::SparseMap& map)
 	std::vector<mrpt::poses::CPose3D> poses;
 	poses.reserve(map.numKeyFrames());
 	for (const auto& [id, kf] : map.keyframes()) poses.push_back(kf.T_world_cam);
-	std::vector<Eigen::Vector3d> points;
+	// The well-triangulated points first; when they give no estimate (too few yet, or no clear
+	// floor among them), every point.
+	std::vector<Eigen::Vector3d> points, all;
 	points.reserve(map.numLandmarks());
+	all.reserve(map.numLandmarks());
 	const double minCos = std::cos(m_opts.minPointParallaxDeg * M_PI / 180.0);
 	for (const auto& [id, lm] : map.landmarks())
+	{
+		all.push_back(lm.p_world);
 		if (!(largestParallaxCos(map, lm) > minCos)) points.push_back(lm.p_world);
-	const auto r = m_estimator.estimate(poses, points);
+	}
+	auto r = m_estimator.estimate(poses, points);
+	if (!r.ok && points.size() < all.size()) r = m_estimator.estimate(poses, all);
 	m_stats.estimates++;
 	m_stats.lastMessage = r.message;
 	if (!r.ok) return std::nullopt;

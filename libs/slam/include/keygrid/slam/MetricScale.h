@@ -30,9 +30,10 @@ struct MetricScaleOptions
 	/** After the first successful estimate, estimate and rescale again every this many new
 	 * keyframes (Default: 10) */
 	int reestimateEvery{10};
-	/** Only map points whose observing keyframes see them under rays this far apart feed the
-	 * floor search [deg]: a point triangulated over a short baseline (the map start's) may lie
-	 * far off its surface, under the floor; 0 = every point (Default: 2 deg) */
+	/** The floor search runs on the map points whose observing keyframes see them under rays
+	 * this far apart [deg], and on every point only when those give no estimate: a point
+	 * triangulated over a short baseline (the map start's) may lie far off its surface, under
+	 * the floor; 0 = every point (Default: 2 deg) */
 	double minPointParallaxDeg{2.0};
 
 	bool enabled() const { return estimator.cameraHeight > 0; }
