@@ -130,3 +130,37 @@ TEST(MetricMaps, AKeyFrameEntersTheGridsAndACorrectionMovesItThere)
 	EXPECT_LT(logOdds(2.025), 0.f);
 	EXPECT_LT(logOdds(1.525), 0.f);
 }
+
+TEST(MetricMaps, AMonocularKeyFramesMapPointsEnterThe3DGridAndFollowItsScale)
+{
+	// A keyframe without depth at the origin with one landmark on its optical axis, 2.025 map
+	// units ahead: the 3D grid holds it in the voxel [2.00, 2.05) and free space before it. A
+	// Sim(3) correction that keeps the keyframe's pose and gives it scale 1.25 puts the point
+	// 2.53 ahead, in [2.50, 2.55), its former voxel on the free part of the ray.
+	mrpt::config::CConfigFileMemory ini(
+		"[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
+		"[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.05\n");
+	slam::MetricMaps maps(ini, {});
+	sfm::SparseMap map;
+	sfm::KeyFrame kf;
+	kf.features.keypoints.resize(1);
+	kf.features.undistorted.resize(1);
+	kf.features.depth.assign(1, 0.f);
+	kf.features.descriptors = cv::Mat(1, 32, CV_8U, cv::Scalar(0));
+	kf.features.levelScale = {1.0};
+	const sfm::KeyFrameId id = map.addKeyFrame(std::move(kf)).id;
+	map.addLandmark({0.0, 0.0, 2.025}, id, 0);
+	maps.insertKeyFrame(map, id, 0.0);
+	const auto* g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>().get();
+	ASSERT_TRUE(g3);
+	auto logOdds = [&](double z) { return g3->logOddsAt(mrpt::math::TPoint3D(0.01, 0.01, z)).value_or(0.f); };
+	EXPECT_GT(logOdds(2.025), 0.f);
+	EXPECT_LT(logOdds(1.025), 0.f);
+	EXPECT_EQ(logOdds(2.525), 0.f);  // never observed
+
+	const auto times = maps.applyCorrection({{id, mrpt::poses::CPose3D()}}, {{id, 1.25}});
+	EXPECT_EQ(times.count(CSubmappedOccupancyGrid3D::GetRuntimeClassIdStatic().className), 1u);
+	EXPECT_GT(logOdds(2.525), 0.f);
+	EXPECT_LT(logOdds(2.025), 0.f);
+	EXPECT_THROW(maps.applyCorrection({{id, mrpt::poses::CPose3D()}}, {{id, -1.0}}), std::invalid_argument);
+}
