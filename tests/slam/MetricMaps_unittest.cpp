@@ -10,6 +10,21 @@
 
 using namespace keygrid;
 
+namespace
+{
+/** The INI of one submapped 3D grid of 5 cm voxels. */
+const char* const kGrid3dIni =
+	"[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
+	"[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.05\n";
+
+/** Log-odds of the voxel on the optical axis of a camera at the origin (world z), z ahead (0:
+ * unknown). The point is inside the voxel, 1 cm off the axis, clear of its faces. */
+float onAxis(const CSubmappedOccupancyGrid3D& g, double z)
+{
+	return g.logOddsAt(mrpt::math::TPoint3D(0.01, 0.01, z)).value_or(0.f);
+}
+}  // namespace
+
 TEST(MetricMaps, CreatesOurPluginsAndMrptMapsFromTheIni)
 {
 	mrpt::config::CConfigFileMemory ini(
@@ -102,10 +117,7 @@ TEST(MetricMaps, AKeyFrameEntersTheGridsAndACorrectionMovesItThere)
 	// One keyframe at the origin facing a flat wall 2.02 m ahead (optical frame: z forward):
 	// the 3D grid holds the wall in the voxel [2.00, 2.05) on the axis and free space before
 	// it. Corrected 0.5 m forward, the wall is in [2.50, 2.55) and its former voxel is free.
-	mrpt::config::CConfigFileMemory ini(
-		"[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
-		"[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.05\n");
-	slam::MetricMaps maps(ini, {});
+	slam::MetricMaps maps(mrpt::config::CConfigFileMemory(kGrid3dIni), {});
 	sfm::SparseMap map;
 	sfm::KeyFrame kf;
 	auto& cam = kf.features.camera;
@@ -119,7 +131,7 @@ TEST(MetricMaps, AKeyFrameEntersTheGridsAndACorrectionMovesItThere)
 	maps.insertKeyFrame(map, id, 0.0);
 	const auto* g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>().get();
 	ASSERT_TRUE(g3);
-	auto logOdds = [&](double z) { return g3->logOddsAt(mrpt::math::TPoint3D(0, 0, z)).value_or(0.f); };
+	const auto logOdds = [&](double z) { return onAxis(*g3, z); };
 	EXPECT_GT(logOdds(2.025), 0.f);
 	EXPECT_LT(logOdds(1.025), 0.f);
 	EXPECT_EQ(logOdds(2.525), 0.f);  // never observed
@@ -137,10 +149,7 @@ TEST(MetricMaps, AMonocularKeyFramesMapPointsEnterThe3DGridAndFollowItsScale)
 	// units ahead: the 3D grid holds it in the voxel [2.00, 2.05) and free space before it. A
 	// Sim(3) correction that keeps the keyframe's pose and gives it scale 1.25 puts the point
 	// 2.53 ahead, in [2.50, 2.55), its former voxel on the free part of the ray.
-	mrpt::config::CConfigFileMemory ini(
-		"[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
-		"[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.05\n");
-	slam::MetricMaps maps(ini, {});
+	slam::MetricMaps maps(mrpt::config::CConfigFileMemory(kGrid3dIni), {});
 	sfm::SparseMap map;
 	sfm::KeyFrame kf;
 	kf.features.keypoints.resize(1);
@@ -153,7 +162,7 @@ TEST(MetricMaps, AMonocularKeyFramesMapPointsEnterThe3DGridAndFollowItsScale)
 	maps.insertKeyFrame(map, id, 0.0);
 	const auto* g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>().get();
 	ASSERT_TRUE(g3);
-	auto logOdds = [&](double z) { return g3->logOddsAt(mrpt::math::TPoint3D(0.01, 0.01, z)).value_or(0.f); };
+	const auto logOdds = [&](double z) { return onAxis(*g3, z); };
 	EXPECT_GT(logOdds(2.025), 0.f);
 	EXPECT_LT(logOdds(1.025), 0.f);
 	EXPECT_EQ(logOdds(2.525), 0.f);  // never observed
