@@ -8,6 +8,8 @@
 
 #include "TestData.h"
 
+#include <stdexcept>
+
 using namespace keygrid;
 
 namespace
@@ -22,6 +24,20 @@ const char* const kGrid3dIni =
 float onAxis(const CSubmappedOccupancyGrid3D& g, double z)
 {
 	return g.logOddsAt(mrpt::math::TPoint3D(0.01, 0.01, z)).value_or(0.f);
+}
+
+/** Inserts keyframe `id` (at the origin, facing something 2.02-2.025 m ahead on its axis) into
+ * `maps` and checks the 3D grid: occupied in the voxel [2.00, 2.05) ahead, free at 1 m, nothing
+ * known beyond. Returns the grid. */
+const CSubmappedOccupancyGrid3D& insertFacingAPoint2mAhead(slam::MetricMaps& maps, const sfm::SparseMap& map, sfm::KeyFrameId id)
+{
+	maps.insertKeyFrame(map, id, 0.0);
+	const auto g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>();
+	if (!g3) throw std::logic_error("no submappedOccupancyGrid3D among the maps");
+	EXPECT_GT(onAxis(*g3, 2.025), 0.f);
+	EXPECT_LT(onAxis(*g3, 1.025), 0.f);
+	EXPECT_EQ(onAxis(*g3, 2.525), 0.f);  // never observed
+	return *g3;
 }
 }  // namespace
 
@@ -128,13 +144,8 @@ TEST(MetricMaps, AKeyFrameEntersTheGridsAndACorrectionMovesItThere)
 	cam.cy = 23.5;
 	kf.depth = cv::Mat(48, 64, CV_32F, cv::Scalar(2.02f));
 	const sfm::KeyFrameId id = map.addKeyFrame(std::move(kf)).id;
-	maps.insertKeyFrame(map, id, 0.0);
-	const auto* g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>().get();
-	ASSERT_TRUE(g3);
-	const auto logOdds = [&](double z) { return onAxis(*g3, z); };
-	EXPECT_GT(logOdds(2.025), 0.f);
-	EXPECT_LT(logOdds(1.025), 0.f);
-	EXPECT_EQ(logOdds(2.525), 0.f);  // never observed
+	const auto& g3 = insertFacingAPoint2mAhead(maps, map, id);
+	const auto logOdds = [&](double z) { return onAxis(g3, z); };
 
 	const auto times = maps.applyCorrection({{id, mrpt::poses::CPose3D(0, 0, 0.5, 0, 0, 0)}});
 	EXPECT_EQ(times.count(CSubmappedOccupancyGrid3D::GetRuntimeClassIdStatic().className), 1u);
@@ -159,13 +170,8 @@ TEST(MetricMaps, AMonocularKeyFramesMapPointsEnterThe3DGridAndFollowItsScale)
 	kf.features.levelScale = {1.0};
 	const sfm::KeyFrameId id = map.addKeyFrame(std::move(kf)).id;
 	map.addLandmark({0.0, 0.0, 2.025}, id, 0);
-	maps.insertKeyFrame(map, id, 0.0);
-	const auto* g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>().get();
-	ASSERT_TRUE(g3);
-	const auto logOdds = [&](double z) { return onAxis(*g3, z); };
-	EXPECT_GT(logOdds(2.025), 0.f);
-	EXPECT_LT(logOdds(1.025), 0.f);
-	EXPECT_EQ(logOdds(2.525), 0.f);  // never observed
+	const auto& g3 = insertFacingAPoint2mAhead(maps, map, id);
+	const auto logOdds = [&](double z) { return onAxis(g3, z); };
 
 	const auto times = maps.applyCorrection({{id, mrpt::poses::CPose3D()}}, {{id, 1.25}});
 	EXPECT_EQ(times.count(CSubmappedOccupancyGrid3D::GetRuntimeClassIdStatic().className), 1u);
