@@ -304,4 +304,10 @@ TEST(LoopCloser, MonocularLoopMeasuresTheScaleDriftAndCorrectsIt)
 	// The first keyframe holds the map's units: not moved.
 	ASSERT_EQ(ev.newPoses.count(0), 1u);
 	EXPECT_LT((ev.newPoses.at(0) - loop::toCPose3D(driftedSim3(0).rigid())).translation().norm(), 1e-9);
+	// Each moved keyframe's scale goes out with its pose (for the maps): the fixed first one
+	// keeps 1, the current one has the scale correction.
+	ASSERT_EQ(ev.newScales.size(), ev.newPoses.size());
+	for (const auto& [id, T] : ev.newPoses) EXPECT_EQ(ev.newScales.count(id), 1u) << "keyframe " << id;
+	EXPECT_NEAR(ev.newScales.at(0), 1.0, 1e-12);
+	EXPECT_DOUBLE_EQ(ev.newScales.at(ev.keyframe), ev.scaleCorrection);
 }

@@ -8,7 +8,38 @@
 
 #include "TestData.h"
 
+#include <stdexcept>
+
 using namespace keygrid;
+
+namespace
+{
+/** The INI of one submapped 3D grid of 5 cm voxels. */
+const char* const kGrid3dIni =
+	"[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
+	"[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.05\n";
+
+/** Log-odds of the voxel on the optical axis of a camera at the origin (world z), z ahead (0:
+ * unknown). The point is inside the voxel, 1 cm off the axis, clear of its faces. */
+float onAxis(const CSubmappedOccupancyGrid3D& g, double z)
+{
+	return g.logOddsAt(mrpt::math::TPoint3D(0.01, 0.01, z)).value_or(0.f);
+}
+
+/** Inserts keyframe `id` (at the origin, facing something 2.02-2.025 m ahead on its axis) into
+ * `maps` and checks the 3D grid: occupied in the voxel [2.00, 2.05) ahead, free at 1 m, nothing
+ * known beyond. Returns the grid. */
+const CSubmappedOccupancyGrid3D& insertFacingAPoint2mAhead(slam::MetricMaps& maps, const sfm::SparseMap& map, sfm::KeyFrameId id)
+{
+	maps.insertKeyFrame(map, id, 0.0);
+	const auto g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>();
+	if (!g3) throw std::logic_error("no submappedOccupancyGrid3D among the maps");
+	EXPECT_GT(onAxis(*g3, 2.025), 0.f);
+	EXPECT_LT(onAxis(*g3, 1.025), 0.f);
+	EXPECT_EQ(onAxis(*g3, 2.525), 0.f);  // never observed
+	return *g3;
+}
+}  // namespace
 
 TEST(MetricMaps, CreatesOurPluginsAndMrptMapsFromTheIni)
 {
@@ -102,10 +133,7 @@ TEST(MetricMaps, AKeyFrameEntersTheGridsAndACorrectionMovesItThere)
 	// One keyframe at the origin facing a flat wall 2.02 m ahead (optical frame: z forward):
 	// the 3D grid holds the wall in the voxel [2.00, 2.05) on the axis and free space before
 	// it. Corrected 0.5 m forward, the wall is in [2.50, 2.55) and its former voxel is free.
-	mrpt::config::CConfigFileMemory ini(
-		"[MappingApplication]\nsubmappedOccupancyGrid3D_count = 1\n"
-		"[MappingApplication_submappedOccupancyGrid3D_00_creationOpts]\nresolution = 0.05\n");
-	slam::MetricMaps maps(ini, {});
+	slam::MetricMaps maps(mrpt::config::CConfigFileMemory(kGrid3dIni), {});
 	sfm::SparseMap map;
 	sfm::KeyFrame kf;
 	auto& cam = kf.features.camera;
@@ -116,17 +144,38 @@ TEST(MetricMaps, AKeyFrameEntersTheGridsAndACorrectionMovesItThere)
 	cam.cy = 23.5;
 	kf.depth = cv::Mat(48, 64, CV_32F, cv::Scalar(2.02f));
 	const sfm::KeyFrameId id = map.addKeyFrame(std::move(kf)).id;
-	maps.insertKeyFrame(map, id, 0.0);
-	const auto* g3 = maps.maps().mapByClass<CSubmappedOccupancyGrid3D>().get();
-	ASSERT_TRUE(g3);
-	auto logOdds = [&](double z) { return g3->logOddsAt(mrpt::math::TPoint3D(0, 0, z)).value_or(0.f); };
-	EXPECT_GT(logOdds(2.025), 0.f);
-	EXPECT_LT(logOdds(1.025), 0.f);
-	EXPECT_EQ(logOdds(2.525), 0.f);  // never observed
+	const auto& g3 = insertFacingAPoint2mAhead(maps, map, id);
+	const auto logOdds = [&](double z) { return onAxis(g3, z); };
 
 	const auto times = maps.applyCorrection({{id, mrpt::poses::CPose3D(0, 0, 0.5, 0, 0, 0)}});
 	EXPECT_EQ(times.count(CSubmappedOccupancyGrid3D::GetRuntimeClassIdStatic().className), 1u);
 	EXPECT_GT(logOdds(2.525), 0.f);
 	EXPECT_LT(logOdds(2.025), 0.f);
 	EXPECT_LT(logOdds(1.525), 0.f);
+}
+
+TEST(MetricMaps, AMonocularKeyFramesMapPointsEnterThe3DGridAndFollowItsScale)
+{
+	// A keyframe without depth at the origin with one landmark on its optical axis, 2.025 map
+	// units ahead: the 3D grid holds it in the voxel [2.00, 2.05) and free space before it. A
+	// Sim(3) correction that keeps the keyframe's pose and gives it scale 1.25 puts the point
+	// 2.53 ahead, in [2.50, 2.55), its former voxel on the free part of the ray.
+	slam::MetricMaps maps(mrpt::config::CConfigFileMemory(kGrid3dIni), {});
+	sfm::SparseMap map;
+	sfm::KeyFrame kf;
+	kf.features.keypoints.resize(1);
+	kf.features.undistorted.resize(1);
+	kf.features.depth.assign(1, 0.f);
+	kf.features.descriptors = cv::Mat(1, 32, CV_8U, cv::Scalar(0));
+	kf.features.levelScale = {1.0};
+	const sfm::KeyFrameId id = map.addKeyFrame(std::move(kf)).id;
+	map.addLandmark({0.0, 0.0, 2.025}, id, 0);
+	const auto& g3 = insertFacingAPoint2mAhead(maps, map, id);
+	const auto logOdds = [&](double z) { return onAxis(g3, z); };
+
+	const auto times = maps.applyCorrection({{id, mrpt::poses::CPose3D()}}, {{id, 1.25}});
+	EXPECT_EQ(times.count(CSubmappedOccupancyGrid3D::GetRuntimeClassIdStatic().className), 1u);
+	EXPECT_GT(logOdds(2.525), 0.f);
+	EXPECT_LT(logOdds(2.025), 0.f);
+	EXPECT_THROW(maps.applyCorrection({{id, mrpt::poses::CPose3D()}}, {{id, -1.0}}), std::invalid_argument);
 }

@@ -16,6 +16,7 @@
 #include "TestData.h"
 
 #include <gtest/gtest.h>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 using namespace keygrid;
@@ -125,6 +126,27 @@ TEST(MonocularSim, CameraHeightGivesAMetricTrajectory)
 	EXPECT_GE(m.metrics.estOccupied, 50u);
 	EXPECT_GE(m.metrics.precision, 0.5);
 	EXPECT_GE(m.metrics.gtBoundarySeenMatched, 40u);
+
+	// The 3D grid from the same map points, in metres on the same floor: every keyframe the 2D
+	// grid took, and its occupied voxels (map_3d.ply, floor frame) between the floor and the
+	// room's 2.6 m ceiling, within what the floor tilt allowed above (5 deg over the room's
+	// 3 m half-extent: 0.26 m).
+	std::size_t grid2dKeyFrames = 0, grid3dKeyFrames = 0;
+	for (const auto& map : report.at("maps"))
+	{
+		if (map.at("class") == "keygrid::CISMOccupancyGrid2D") grid2dKeyFrames = map.at("keyframes").get<std::size_t>();
+		if (map.at("class") == "keygrid::CSubmappedOccupancyGrid3D") grid3dKeyFrames = map.at("keyframes").get<std::size_t>();
+	}
+	EXPECT_GT(grid3dKeyFrames, 0u);
+	EXPECT_EQ(grid3dKeyFrames, grid2dKeyFrames);
+	std::istringstream ply(test::readTextFile(o.output + "/map_3d.ply"));
+	std::string line;
+	while (std::getline(ply, line) && line != "end_header") {}
+	std::size_t voxels = 0, inRoom = 0;
+	for (double x, y, z; ply >> x >> y >> z; voxels++)
+		if (z > -0.26 && z < 2.6 + 0.26) inRoom++;
+	EXPECT_GE(voxels, 200u);
+	EXPECT_GE(inRoom, 0.95 * voxels) << inRoom << " of " << voxels;
 }
 
 // A camera that only turns (the room of room_pan_rs seen from one point, no rolling shutter)

@@ -152,6 +152,7 @@ LoopClosureEvent LoopCloser::correctSim3(sfm::KeyFrameId cur, sfm::KeyFrameId ca
 		// The camera's centre and orientation; its scale goes into its landmarks below.
 		m_map.keyframe(c.id).T_world_cam = toCPose3D(c.S_world_kf_new.rigid());
 		ev.newPoses[c.id] = m_map.keyframe(c.id).T_world_cam;
+		ev.newScales[c.id] = c.S_world_kf_new.s / oldS.at(c.id).s;
 	}
 	detail::moveLandmarksWithKeyFrames(m_map, oldS, newS);
 	ev.correctionMetres = (newS.at(cur).t - oldS.at(cur).t).norm();

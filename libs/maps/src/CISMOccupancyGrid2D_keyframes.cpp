@@ -34,19 +34,29 @@ void CISMOccupancyGrid2D::insertKeyFrame(const maps::MapKeyFrame& kf, const maps
 
 bool CISMOccupancyGrid2D::applyCorrection(const maps::MapCorrection& correction)
 {
-	if (!(correction.scale > 0) || !std::isfinite(correction.scale))
-		throw std::invalid_argument("CISMOccupancyGrid2D::applyCorrection: scale " + std::to_string(correction.scale) + " is not a positive finite factor");
+	const auto checkFactor = [](double f, const std::string& what) {
+		if (!(f > 0) || !std::isfinite(f))
+			throw std::invalid_argument("CISMOccupancyGrid2D::applyCorrection: " + what + " " + std::to_string(f) + " is not a positive finite factor");
+	};
+	checkFactor(correction.scale, "scale");
+	for (const auto& [id, c] : correction.poses) checkFactor(c.scale, "keyframe " + std::to_string(id) + " scale");
+	const auto scaleRays = [](KeyframeRays& kf, double factor) {
+		const float s = static_cast<float>(factor);
+		for (auto& p : kf.points_cam) p = mrpt::math::TPoint3Df(p.x * s, p.y * s, p.z * s);
+	};
 	// A rescaled world: the stored rays (camera frame) and every pose's translation scale
 	// with it, also those of keyframes stored before the floor frame was known.
 	if (correction.scale != 1.0)
 		for (auto& [id, kf] : m_keyframes)
 		{
-			const float s = static_cast<float>(correction.scale);
-			for (auto& p : kf.points_cam) p = mrpt::math::TPoint3Df(p.x * s, p.y * s, p.z * s);
+			scaleRays(kf, correction.scale);
 			kf.T_world_cam.x(kf.T_world_cam.x() * correction.scale);
 			kf.T_world_cam.y(kf.T_world_cam.y() * correction.scale);
 			kf.T_world_cam.z(kf.T_world_cam.z() * correction.scale);
 		}
+	// A keyframe's own similarity (monocular loop correction): its rays grow with it.
+	for (const auto& [id, c] : correction.poses)
+		if (const auto it = m_keyframes.find(id); c.scale != 1.0 && it != m_keyframes.end()) scaleRays(it->second, c.scale);
 	if (correction.T_world_floor) setExternalFloorPose(*correction.T_world_floor);
 	if (!floorKnown()) return false;  // nothing integrated yet: no floor frame
 	std::map<uint64_t, mrpt::poses::CPose3D> newPoses;

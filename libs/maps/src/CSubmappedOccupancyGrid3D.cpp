@@ -181,6 +181,7 @@ std::size_t CSubmappedOccupancyGrid3D::memoryBytes() const
 {
 	std::size_t b = 0;
 	for (const auto& s : m_submaps) b += s.grid.memoryBytes();
-	for (const auto& kv : m_keyframes) b += kv.second.depth.total() * kv.second.depth.elemSize();
+	for (const auto& kv : m_keyframes)
+		b += kv.second.depth.total() * kv.second.depth.elemSize() + kv.second.points_cam.size() * sizeof(mrpt::math::TPoint3Df);
 	return b;
 }

@@ -13,22 +13,65 @@
 
 using namespace keygrid;
 
+void CSubmappedOccupancyGrid3D::checkNewFrame(const char* caller, std::optional<uint64_t> keyframeId, double travelled) const
+{
+	if (keyframeId && m_keyframes.count(*keyframeId))
+		throw std::invalid_argument(
+			std::string(caller) + ": keyframe id " + std::to_string(*keyframeId) + " already inserted");
+	if (!std::isfinite(travelled) || travelled < 0)
+		throw std::invalid_argument(
+			std::string(caller) + ": travelled = " + std::to_string(travelled) + " must be >= 0 m");
+}
+
 CSubmappedOccupancyGrid3D::InsertResult CSubmappedOccupancyGrid3D::insertDepthFrame(
 	const cv::Mat& depth_m, const core::RgbdCamera& cam, const mrpt::poses::CPose3D& T_world_cam,
 	double travelled, std::optional<uint64_t> keyframeId)
 {
-	if (keyframeId && m_keyframes.count(*keyframeId))
-		throw std::invalid_argument(
-			"insertDepthFrame: keyframe id " + std::to_string(*keyframeId) + " already inserted");
-	if (!std::isfinite(travelled) || travelled < 0)
-		throw std::invalid_argument(
-			"insertDepthFrame: travelled = " + std::to_string(travelled) + " must be >= 0 m");
+	checkNewFrame("insertDepthFrame", keyframeId, travelled);
 	insertionOptions.conflict.validate();
+	const FrameVoxelUpdates upd = integrator().castFrame(depth_m, cam, T_world_cam, m_resolution);
+	std::optional<KeyframeRecord> record;
+	if (keyframeId)
+	{
+		record.emplace();
+		record->id = *keyframeId;
+		record->T_world_cam = T_world_cam;
+		record->travelled = travelled;
+		record->camera = cam;
+		if (insertionOptions.storeKeyframeDepth) record->depth = depth_m.clone();
+	}
+	return integrateFrame(upd, travelled, std::move(record));
+}
+
+CSubmappedOccupancyGrid3D::InsertResult CSubmappedOccupancyGrid3D::insertMapPoints(
+	uint64_t keyframeId, const mrpt::poses::CPose3D& T_world_cam,
+	const std::vector<mrpt::math::TPoint3D>& points_world, const core::RgbdCamera& cam, double travelled)
+{
+	checkNewFrame("insertMapPoints", keyframeId, travelled);
+	insertionOptions.conflict.validate();
+	KeyframeRecord k;
+	k.id = keyframeId;
+	k.T_world_cam = T_world_cam;
+	k.travelled = travelled;
+	k.camera = cam;
+	k.fromMapPoints = true;
+	std::vector<mrpt::math::TPoint3Df> ends;
+	ends.reserve(points_world.size());
+	k.points_cam.reserve(points_world.size());
+	for (const auto& p : points_world)
+	{
+		ends.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+		const auto q = T_world_cam.inverseComposePoint(p);
+		k.points_cam.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
+	}
+	const FrameVoxelUpdates upd = integrator().castPoints(T_world_cam.translation(), ends, m_resolution);
+	return integrateFrame(upd, travelled, std::move(k));
+}
+
+CSubmappedOccupancyGrid3D::InsertResult CSubmappedOccupancyGrid3D::integrateFrame(
+	const FrameVoxelUpdates& upd, double travelled, std::optional<KeyframeRecord> record)
+{
 	m_modeMachine.setOptions(insertionOptions.conflict);
-
-	DepthFrameIntegrator& integ = integrator();
-	const FrameVoxelUpdates upd = integ.castFrame(depth_m, cam, T_world_cam, m_resolution);
-
 	InsertResult r;
 	r.rays = upd.rays;
 	r.voxelVisits = upd.voxelVisits;
@@ -42,31 +85,25 @@ CSubmappedOccupancyGrid3D::InsertResult CSubmappedOccupancyGrid3D::insertDepthFr
 	{
 		r.conflict = true;
 		Submap s(m_resolution);
-		s.anchorKeyframe = keyframeId ? *keyframeId : m_lastKeyframe.value_or(0);
+		s.anchorKeyframe = record ? record->id : m_lastKeyframe.value_or(0);
 		m_submaps.push_back(std::move(s));
 		m_active = m_submaps.size() - 1;
 	}
-	integ.apply(m_submaps[m_active].grid, upd, travelled);
+	integrator().apply(m_submaps[m_active].grid, upd, travelled);
 	r.submap = m_active;
 
-	if (keyframeId)
+	if (record)
 	{
-		KeyframeRecord k;
-		k.id = *keyframeId;
-		k.T_world_cam = T_world_cam;
-		k.travelled = travelled;
-		k.submap = m_active;
-		k.camera = cam;
-		if (insertionOptions.storeKeyframeDepth) k.depth = depth_m.clone();
+		record->submap = m_active;
 		Submap& s = m_submaps[m_active];
-		if (s.keyframes.empty() && !r.conflict) s.anchorKeyframe = k.id;
-		s.keyframes.push_back(k.id);
-		m_keyframes.emplace(k.id, std::move(k));
-		m_lastKeyframe = *keyframeId;
+		if (s.keyframes.empty() && !r.conflict) s.anchorKeyframe = record->id;
+		s.keyframes.push_back(record->id);
+		m_lastKeyframe = record->id;
+		const uint64_t id = record->id;
+		m_keyframes.emplace(id, std::move(*record));
 	}
 	return r;
 }
-
 
 bool CSubmappedOccupancyGrid3D::internal_insertObservation(
 	const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)

@@ -98,7 +98,15 @@ void readGrid(CArchive& in, VoxelBlockGrid& g)
 // Version 1 adds morphingOptions.interpolation after morphingOptions.threads;
 // version-0 archives load with Nearest, the behaviour they were written with.
 // Version 2 adds morphingOptions.maxKeyframesPerBlock after it (older: 0 = all).
-uint8_t CSubmappedOccupancyGrid3D::serializeGetVersion() const { return 2; }
+// Version 3 adds, per keyframe after its depth, whether it was integrated from map points and
+// those points (camera frame). Written only by a grid holding such a keyframe, so a grid of
+// depth keyframes keeps the version-2 archive it always had.
+uint8_t CSubmappedOccupancyGrid3D::serializeGetVersion() const
+{
+	for (const auto& [id, k] : m_keyframes)
+		if (k.fromMapPoints) return 3;
+	return 2;
+}
 
 void CSubmappedOccupancyGrid3D::serializeTo(mrpt::serialization::CArchive& out) const
 {
@@ -133,6 +141,7 @@ void CSubmappedOccupancyGrid3D::serializeTo(mrpt::serialization::CArchive& out) 
 		writeGrid(out, s.grid);
 	}
 	// Keyframes.
+	const bool withMapPoints = serializeGetVersion() >= 3;
 	out << uint64_t(m_keyframes.size());
 	for (const auto& [id, k] : m_keyframes)
 	{
@@ -147,6 +156,11 @@ void CSubmappedOccupancyGrid3D::serializeTo(mrpt::serialization::CArchive& out) 
 			out << int32_t(d.rows) << int32_t(d.cols);
 			out.WriteBufferFixEndianness(d.ptr<float>(), d.total());
 		}
+		if (withMapPoints)
+		{
+			out << k.fromMapPoints << uint64_t(k.points_cam.size());
+			for (const auto& p : k.points_cam) out << p.x << p.y << p.z;
+		}
 	}
 }
 
@@ -157,6 +171,7 @@ void CSubmappedOccupancyGrid3D::serializeFrom(mrpt::serialization::CArchive& in,
 		case 0:
 		case 1:
 		case 2:
+		case 3:
 		{
 			in >> m_resolution;
 			auto& io = insertionOptions.integration;
@@ -238,6 +253,13 @@ void CSubmappedOccupancyGrid3D::serializeFrom(mrpt::serialization::CArchive& in,
 					in >> rows >> cols;
 					k.depth.create(rows, cols, CV_32FC1);
 					in.ReadBufferFixEndianness(k.depth.ptr<float>(), k.depth.total());
+				}
+				if (version >= 3)
+				{
+					uint64_t np = 0;
+					in >> k.fromMapPoints >> np;
+					k.points_cam.resize(np);
+					for (auto& p : k.points_cam) in >> p.x >> p.y >> p.z;
 				}
 				m_keyframes.emplace(k.id, std::move(k));
 			}

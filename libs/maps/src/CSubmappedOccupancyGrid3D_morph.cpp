@@ -80,3 +80,58 @@ CSubmappedOccupancyGrid3D::ReintegrationStats
 	st.seconds = timer.Tac();
 	return st;
 }
+
+bool CSubmappedOccupancyGrid3D::builtFromMapPoints() const
+{
+	if (m_keyframes.empty()) return false;
+	for (const auto& [id, rec] : m_keyframes)
+		if (!rec.fromMapPoints) return false;
+	return true;
+}
+
+CSubmappedOccupancyGrid3D::ReintegrationStats
+	CSubmappedOccupancyGrid3D::rebuildFromMapPoints(const TrajectoryCorrection& corr, double worldScale)
+{
+	if (!builtFromMapPoints())
+		throw std::logic_error("rebuildFromMapPoints: the grid holds keyframes integrated from depth");
+	mrpt::system::CTicTac timer;
+	const auto scalePoints = [](std::vector<mrpt::math::TPoint3Df>& pts, double factor) {
+		const float f = static_cast<float>(factor);
+		for (auto& p : pts) p = mrpt::math::TPoint3Df(p.x * f, p.y * f, p.z * f);
+	};
+	ReintegrationStats st;
+	DepthFrameIntegrator& integ = integrator();
+	Submap s(m_resolution);
+	std::vector<mrpt::math::TPoint3Df> ends;
+	for (auto& [id, rec] : m_keyframes)
+	{
+		if (worldScale != 1.0)
+		{
+			scalePoints(rec.points_cam, worldScale);
+			rec.T_world_cam.x(rec.T_world_cam.x() * worldScale);
+			rec.T_world_cam.y(rec.T_world_cam.y() * worldScale);
+			rec.T_world_cam.z(rec.T_world_cam.z() * worldScale);
+			rec.travelled *= worldScale;
+		}
+		if (const auto it = corr.find(id); it != corr.end())
+		{
+			rec.T_world_cam = it->second.T_world_cam_new;
+			if (it->second.scale != 1.0) scalePoints(rec.points_cam, it->second.scale);
+		}
+		ends.clear();
+		for (const auto& p : rec.points_cam)
+		{
+			const auto q = rec.T_world_cam.composePoint(mrpt::math::TPoint3D(p.x, p.y, p.z));
+			ends.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
+		}
+		integ.apply(s.grid, integ.castPoints(rec.T_world_cam.translation(), ends, m_resolution), rec.travelled);
+		rec.submap = 0;
+		s.keyframes.push_back(id);
+		++st.frames;
+	}
+	s.anchorKeyframe = m_keyframes.begin()->first;
+	m_submaps.assign(1, std::move(s));
+	m_active = 0;
+	st.seconds = timer.Tac();
+	return st;
+}

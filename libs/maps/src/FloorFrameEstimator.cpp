@@ -506,7 +506,8 @@ bool FloorFrameEstimator::addKeyframe(
 	return due() && reestimate();
 }
 
-bool FloorFrameEstimator::updatePoses(const std::map<uint64_t, mrpt::poses::CPose3D>& newPoses)
+bool FloorFrameEstimator::updatePoses(
+	const std::map<uint64_t, mrpt::poses::CPose3D>& newPoses, const std::map<uint64_t, double>& scales)
 {
 	if (m_given) return false;
 	bool any = false;
@@ -516,6 +517,13 @@ bool FloorFrameEstimator::updatePoses(const std::map<uint64_t, mrpt::poses::CPos
 			it->second = T;
 			any = true;
 		}
+	if (!scales.empty())
+		for (auto& smp : m_samples)
+			if (const auto it = scales.find(smp.keyframe); it != scales.end())
+			{
+				const float f = static_cast<float>(it->second);
+				smp.p_cam = mrpt::math::TPoint3Df(smp.p_cam.x * f, smp.p_cam.y * f, smp.p_cam.z * f);
+			}
 	return any && reestimate();
 }
 

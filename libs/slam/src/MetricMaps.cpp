@@ -237,8 +237,17 @@ cv::Mat MetricMaps::depthOf(const sfm::KeyFrame& kf) const
 	return m_images->load(kf).depth;
 }
 
-std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses)
+std::map<std::string, double> MetricMaps::applyCorrection(
+	const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses, const std::map<sfm::KeyFrameId, double>& newScales)
 {
+	for (const auto& [id, s] : newScales)
+		if (!(s > 0) || !std::isfinite(s))
+			throw std::invalid_argument("MetricMaps::applyCorrection: keyframe " + std::to_string(id) + " scale " +
+										std::to_string(s) + " is not a positive finite factor");
+	const auto scaleOf = [&](sfm::KeyFrameId id) {
+		const auto it = newScales.find(id);
+		return it != newScales.end() ? it->second : 1.0;
+	};
 	std::map<std::string, double> out;
 	maps::MapCorrection correction;
 	{
@@ -247,12 +256,12 @@ std::map<std::string, double> MetricMaps::applyCorrection(const std::map<sfm::Ke
 		// an older one, see floorReanchorShift).
 		const auto t0 = std::chrono::steady_clock::now();
 		std::map<uint64_t, mrpt::poses::CPose3D> np(newPoses.begin(), newPoses.end());
-		if (!m_floorFromHeight) m_floor.updatePoses(np);
+		if (!m_floorFromHeight) m_floor.updatePoses(np, newScales);
 		correction.T_world_floor = T_world_floor();
 		out["floor"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}
 	for (const auto& [id, T] : newPoses)
-		if (m_insertedPoses.count(id)) correction.poses[id] = PoseCorrection{m_insertedPoses.at(id), T};
+		if (m_insertedPoses.count(id)) correction.poses[id] = PoseCorrection{m_insertedPoses.at(id), T, scaleOf(id)};
 	for (const auto& [name, sec] : dispatchCorrection(correction)) out[name] = sec;
 	for (const auto& [id, T] : newPoses)
 		if (m_insertedPoses.count(id)) m_insertedPoses[id] = T;

@@ -411,7 +411,7 @@ std::optional<loop::LoopClosureEvent> System::closeLoops(const KeyFrameJob& job,
 	// measured again on the corrected map at the next keyframe (the correction itself keeps
 	// the units of the first keyframe, so the two do not pull the scale against each other).
 	if (m_metricScale) m_metricScale->requestEstimate();
-	PoseCorrection c{PoseCorrection::Source::LoopClosure, ev->newPoses, job.keyframe};
+	PoseCorrection c{PoseCorrection::Source::LoopClosure, ev->newPoses, job.keyframe, &ev->newScales};
 	for (const auto& [name, sec] : publishCorrection(c, tf)) m_timings.add(name, sec);
 	return ev;
 }
@@ -437,7 +437,9 @@ std::map<std::string, double> System::publishCorrection(const PoseCorrection& c,
 	// maps are re-anchored.
 	std::map<std::string, double> seconds;
 	if (!m_maps) return seconds;
-	for (const auto& [name, sec] : m_maps->applyCorrection(c.newPoses)) seconds["map_correction:" + name] = sec;
+	const std::map<sfm::KeyFrameId, double> noScales;
+	for (const auto& [name, sec] : m_maps->applyCorrection(c.newPoses, c.newScales ? *c.newScales : noScales))
+		seconds["map_correction:" + name] = sec;
 	if (c.source == PoseCorrection::Source::LoopClosure) m_maps->notifyLoopClosure();
 	return seconds;
 }

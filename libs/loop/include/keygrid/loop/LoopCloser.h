@@ -113,6 +113,10 @@ struct LoopClosureEvent
 	bool mergedMap{false};
 	double seconds{0};
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> newPoses;
+	/** Monocular: per keyframe of newPoses, the scale of its similarity (s_new / s_old): what
+	 * it holds in its camera frame grows by this factor (its landmarks did). Empty for a
+	 * rigid correction. */
+	std::map<sfm::KeyFrameId, double> newScales;
 };
 
 /** Whether loop detection closed a loop at a keyframe, or why not. */

@@ -254,9 +254,12 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	void insertKeyFrame(const maps::MapKeyFrame& kf, const maps::KeyFrameFeed& feed) override;
 	/** The grid reads a keyframe's own map points at insertion, not the landmark set. */
 	void syncLandmarks(const maps::LandmarkSource&) override {}
-	/** Takes correction.T_world_floor when given, then rebuilds under the corrected poses of
-	 * its keyframes (applyTrajectoryCorrection()); false while the floor frame is unknown
-	 * (nothing integrated yet). */
+	/** Scales the stored rays (camera frame) by correction.scale (with every pose's
+	 * translation) and each named keyframe's rays by its own PoseCorrection::scale, takes
+	 * correction.T_world_floor when given, then rebuilds under the corrected poses of its
+	 * keyframes (applyTrajectoryCorrection()); false while the floor frame is unknown (nothing
+	 * integrated yet). Throws std::invalid_argument, before changing anything, for a factor
+	 * that is not positive and finite. */
 	bool applyCorrection(const maps::MapCorrection& correction) override;
 	/** The 2D grid has no mapping mode a loop closure would change. */
 	void notifyLoopClosure() override {}

@@ -18,7 +18,12 @@
  * an automatic id, travelled distance accumulated from the poses).
  *
  * In a SLAM run (maps::KeyFrameMap, CSubmappedOccupancyGrid3D_keyframes.cpp) the grid takes
- * each keyframe's depth with the camera's path length and is morphed on corrections.
+ * each keyframe's depth with the camera's path length and is morphed on corrections. A keyframe
+ * without depth (monocular) brings its map points instead (insertMapPoints(): a ray from the
+ * camera to each, as the ISM 2D grid takes them); a grid made of those keeps them in their
+ * keyframes' camera frames and is rebuilt from them on a correction, which may then also
+ * scale the world (a monocular map given metric scale) and each keyframe (a Sim(3) loop
+ * correction).
  *
  * Threading: call one map from one thread at a time; integration and morphing use their own
  * worker threads (options `threads`, `morphThreads`) and give the same result for any count.
@@ -63,6 +68,10 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 		core::RgbdCamera camera;
 		/** Depth [m] (CV_32FC1), kept only when insertionOptions.storeKeyframeDepth. */
 		cv::Mat depth;
+		/** Integrated from its map points (insertMapPoints()), kept here in its camera frame
+		 * (optical, map units of the last correction). */
+		bool fromMapPoints{false};
+		std::vector<mrpt::math::TPoint3Df> points_cam;
 	};
 
 	/** One consistent piece of the map, anchored at the keyframe that opened it. */
@@ -146,6 +155,17 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 		const cv::Mat& depth_m, const core::RgbdCamera& cam,
 		const mrpt::poses::CPose3D& T_world_cam, double travelled,
 		std::optional<uint64_t> keyframeId);
+	/** Integrates a keyframe's map points [world] seen from T_world_cam (a keyframe without
+	 * depth, e.g. monocular): a 3D DDA ray from the camera centre to each point, the voxels
+	 * before it free and its voxel occupied (DepthFrameIntegrator::castPoints: the ranges,
+	 * clamping and endpoint discretization of depth frames), through the same evaluation
+	 * against the active submap, mode machine and submap opening as insertDepthFrame(). The
+	 * keyframe is recorded with its points in its camera frame (`cam` only serves the view
+	 * cone should the grid be morphed). Throws std::invalid_argument on a repeated keyframe id
+	 * or a bad travelled distance. */
+	InsertResult insertMapPoints(
+		uint64_t keyframeId, const mrpt::poses::CPose3D& T_world_cam,
+		const std::vector<mrpt::math::TPoint3D>& points_world, const core::RgbdCamera& cam, double travelled);
 	/** Signals a loop closure: the next frame is integrated in localization mode. */
 	void notifyLoopClosure() override { m_modeMachine.notifyRevisit(); }
 	/** Signals a relocalization: same effect as a loop closure. */
@@ -187,16 +207,27 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	 * corrected pose. Requires insertionOptions.storeKeyframeDepth (throws std::logic_error
 	 * naming the first keyframe without depth otherwise). */
 	ReintegrationStats reintegrateAtCorrectedPoses(const TrajectoryCorrection& corr);
+	/** True when every keyframe was integrated from its map points (and there is one). */
+	bool builtFromMapPoints() const;
+	/** A grid built from map points (builtFromMapPoints()): the world scaled by `worldScale`
+	 * about its origin (every keyframe's stored points and translation, its travelled
+	 * distance), then each keyframe of `corr` at its corrected pose with its points scaled by
+	 * its PoseCorrection::scale; the keyframes' points re-integrated, in id order, into one
+	 * submap. Throws std::logic_error for a grid not built from map points. */
+	ReintegrationStats rebuildFromMapPoints(const TrajectoryCorrection& corr, double worldScale = 1.0);
 	/** @} */
 
 	/** @name In a SLAM run (maps::KeyFrameMap)
 	 * @{ */
-	/** insertDepthFrame() of the keyframe's depth at its pose and path length; nothing
-	 * without depth. */
+	/** insertDepthFrame() of the keyframe's depth at its pose and path length; without depth,
+	 * insertMapPoints() of its map points (nothing when it has none either). */
 	void insertKeyFrame(const maps::MapKeyFrame& kf, const maps::KeyFrameFeed& feed) override;
 	/** The grid is made of depth, not of the frontend's landmarks. */
 	void syncLandmarks(const maps::LandmarkSource&) override {}
-	/** morphAndMergeSubmaps(correction.poses); always true. */
+	/** A grid built from map points: rebuildFromMapPoints() with the correction's scales.
+	 * Otherwise morphAndMergeSubmaps(correction.poses), which cannot scale: throws
+	 * std::invalid_argument for a scale other than 1 (world or keyframe) on a grid with
+	 * keyframes. False when there is nothing to re-anchor (no keyframes and a scale). */
 	bool applyCorrection(const maps::MapCorrection& correction) override;
 	// notifyLoopClosure(): see Integration.
 	/** The grid stays in the SLAM world; its exports take the frame they are written in. */
@@ -223,7 +254,8 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	/** Writes the occupied voxel centres as an ASCII PLY point cloud, mapped into `frame`
 	 * (each centre moved exactly; frame.comment is a PLY comment line). */
 	void saveOccupiedAsPly(const std::string& path, const maps::ExportFrame& frame = {}) const;
-	/** Heap bytes of all submap grids (VoxelBlockGrid::memoryBytes) plus stored depth. */
+	/** Heap bytes of all submap grids (VoxelBlockGrid::memoryBytes) plus stored depth and map
+	 * points. */
 	std::size_t memoryBytes() const;
 	/** @} */
 
@@ -247,6 +279,12 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 
    private:
 	DepthFrameIntegrator& integrator();
+	/** Throws std::invalid_argument (naming `caller`) for a known keyframe id or a bad
+	 * travelled distance. */
+	void checkNewFrame(const char* caller, std::optional<uint64_t> keyframeId, double travelled) const;
+	/** The rest of an insertion: `upd` against the active submap, mode machine, a new submap
+	 * on a conflict, the update, and `record` (when given) filed as a keyframe. */
+	InsertResult integrateFrame(const FrameVoxelUpdates& upd, double travelled, std::optional<KeyframeRecord> record);
 
 	double m_resolution{0.05};
 	std::vector<Submap> m_submaps;

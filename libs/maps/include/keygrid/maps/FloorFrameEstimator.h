@@ -161,9 +161,11 @@ class FloorFrameEstimator
 	bool addKeyframe(
 		uint64_t id, const mrpt::poses::CPose3D& T_world_cam,
 		const std::vector<mrpt::math::TPoint3Df>& samples_cam, double stamp = 0);
-	/** New poses of known keyframes (others are ignored), then a re-estimate. Returns true
-	 * when the floor frame changed. */
-	bool updatePoses(const std::map<uint64_t, mrpt::poses::CPose3D>& newPoses);
+	/** New poses of known keyframes (others are ignored), then a re-estimate. `scales` (id ->
+	 * factor, absent: 1; a monocular Sim(3) correction) scales a keyframe's samples in its
+	 * camera frame. Returns true when the floor frame changed. */
+	bool updatePoses(
+		const std::map<uint64_t, mrpt::poses::CPose3D>& newPoses, const std::map<uint64_t, double>& scales = {});
 	/** Re-estimates from the reservoir now; true when the floor frame changed. */
 	bool reestimate();
 

@@ -70,6 +70,11 @@ struct PoseCorrection
 {
 	mrpt::poses::CPose3D T_world_cam_old;
 	mrpt::poses::CPose3D T_world_cam_new;
+	/** What the keyframe holds in its camera frame (map points, rays) grows by this factor:
+	 * new map units per old in that frame. A Sim(3) correction of a monocular map (loop
+	 * closing) gives each keyframe its own similarity, scale included, and the landmarks it
+	 * placed follow it; 1 for a rigid correction. */
+	double scale{1.0};
 };
 /** keyframe id -> {old pose, new pose}. */
 using TrajectoryCorrection = std::map<uint64_t, PoseCorrection>;

@@ -45,16 +45,18 @@ struct KeyFrameFeed
 /** A trajectory correction (loop closure, final refinement) as the maps take it. */
 struct MapCorrection
 {
-	/** The keyframes that moved: the pose each was inserted with (or last corrected to) and
-	 * its corrected pose. */
+	/** The keyframes that moved: the pose each was inserted with (or last corrected to), its
+	 * corrected pose and the factor its camera-frame content grows by (PoseCorrection::scale:
+	 * a monocular Sim(3) loop correction; 1 otherwise). */
 	TrajectoryCorrection poses;
 	/** The run's floor frame under the corrected poses (given, or the newest estimate);
 	 * nullopt while none is known. */
 	std::optional<mrpt::poses::CPose3D> T_world_floor;
 	/** The world was scaled by this factor about its origin (x -> scale x) before the poses
 	 * moved to their corrected values: a monocular map given metric scale. What a map holds in
-	 * a keyframe's camera frame (map points, rays) scales by it, and so does the translation of
-	 * every keyframe pose the correction does not name. 1 for a loop closure or a refinement. */
+	 * a keyframe's camera frame (map points, rays) scales by it (and then by the keyframe's own
+	 * poses[id].scale), and so does the translation of every keyframe pose the correction does
+	 * not name. 1 for a loop closure or a refinement. */
 	double scale{1.0};
 };
 

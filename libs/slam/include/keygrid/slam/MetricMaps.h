@@ -20,13 +20,15 @@
  * maps themselves (and their serialized .bin files) stay in the SLAM world, where loop
  * closures re-anchor them.
  *
- * Monocular keyframes carry no depth: the 2D grid takes their map points (the landmarks each
- * observes; a ray from the camera to each), the 3D grid and MRPT's depth-fed maps get nothing.
+ * Monocular keyframes carry no depth: the 2D and 3D grids take their map points (the landmarks
+ * each observes; a ray from the camera to each), MRPT's depth-fed maps get nothing.
  * With a camera height (slam::MetricScale) the floor frame is the floor plane that estimate
  * found (useFloorFromCameraHeight), and each rescale of the map reaches the maps as a
  * correction with a scale (applyRescale): everything inserted before is rebuilt in the new
  * scale. Without one, the floor estimator runs on the map points and the maps share the map's
- * arbitrary unit.
+ * arbitrary unit. A Sim(3) loop correction gives each keyframe its own scale
+ * (applyCorrection's newScales): the maps and the floor estimate scale what they hold in that
+ * keyframe's camera frame by it.
  */
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CHOCPointsMap.h>
@@ -125,9 +127,15 @@ class MetricMaps
 	void setImageSource(const KeyFrameImageSource* images) { m_images = images; }
 	/** Re-anchors the maps on corrected keyframe poses (kf id -> new T_world_cam): the floor
 	 * is re-estimated under them, the 2D grid is rebuilt from its stored keyframe
-	 * observations, the 3D grid morphed and merged.
-	 * Returns seconds spent per map name ("floor" and each map that re-anchored). */
-	std::map<std::string, double> applyCorrection(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses);
+	 * observations, the 3D grid morphed and merged (rebuilt from its stored map points when
+	 * it was built from them). `newScales` (kf id -> factor, absent: 1) is a Sim(3)
+	 * correction's scale per keyframe (monocular loop closing): what a map and the floor
+	 * estimate hold in that keyframe's camera frame grows by it.
+	 * Returns seconds spent per map name ("floor" and each map that re-anchored). Throws
+	 * std::invalid_argument for a factor that is not positive and finite. */
+	std::map<std::string, double> applyCorrection(
+		const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses,
+		const std::map<sfm::KeyFrameId, double>& newScales = {});
 
 	/** Copies the frontend's landmarks (positions, descriptors, histograms) into every
 	 * hocPointsMap; its descriptor options become `hoc` (the frontend's [hoc] section), so the

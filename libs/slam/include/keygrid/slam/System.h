@@ -239,6 +239,9 @@ class System
 		const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses;
 		/** LoopClosure: the keyframe that closed the loop (created by the frame being tracked) */
 		sfm::KeyFrameId keyframe;
+		/** Monocular loop closure (Sim(3)): per keyframe of newPoses, the factor its
+		 * camera-frame content grows by (LoopClosureEvent::newScales); null or absent: 1 */
+		const std::map<sfm::KeyFrameId, double>* newScales{nullptr};
 	};
 	/** The one place a correction goes out: the map's correction count and the tracker (loop
 	 * closures), the frame `tf` that created the keyframe (sequential mode, else null), the
