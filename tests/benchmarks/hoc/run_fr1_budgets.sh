@@ -6,12 +6,10 @@
 # Usage: tests/benchmarks/hoc/run_fr1_budgets.sh [BUILD_DIR=build] [OUT_DIR=out/hoc_fr1]
 # Prints per budget: ATE RMSE [cm] / tracked frames / final landmarks; then the means.
 set -euo pipefail
-SRC="$(cd "$(dirname "$0")/../../.." && pwd)"
-BUILD="$(cd "${1:-$SRC/build}" && pwd)"
-OUT="${2:-$SRC/out/hoc_fr1}"
+source "$(dirname "${BASH_SOURCE[0]}")/hoc_configs.sh"
+hoc_dirs out/hoc_fr1 "$@"
 DATA="${KEYGRID_SHARED_DATA:-$SRC/../shared/data}/tum_fr1_rpy_first250"
 [ -d "$DATA" ] || { echo "run_fr1_budgets.sh: $DATA not found" >&2; exit 1; }
-mkdir -p "$OUT"
 for hoc in false true; do
 	for nf in 980 990 1000 1010 1020; do
 		"$BUILD/bin/keygrid-slam" --quiet --config "$SRC/config/tum_fr1.ini" --set "features.num_features=$nf; hoc.enabled=$hoc" \

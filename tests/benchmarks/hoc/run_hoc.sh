@@ -11,15 +11,11 @@
 # Writes OUT_DIR/hoc_table.md and OUT_DIR/<scene>_<std|hoc>/frames.csv (map size over time);
 # tests/benchmarks/hoc/plot_map_size.py OUT_DIR doc/images/hoc-map-size.png draws the plot.
 set -euo pipefail
-SRC="$(cd "$(dirname "$0")/../../.." && pwd)"
-BUILD="$(cd "${1:-$SRC/build}" && pwd)"
-OUT="${2:-$SRC/out/hoc}"
-BIN="$BUILD/bin"
+source "$(dirname "${BASH_SOURCE[0]}")/hoc_configs.sh"
+hoc_dirs out/hoc "$@"
 DATA="${KEYGRID_SHARED_DATA:-$SRC/../shared/data}"
-mkdir -p "$OUT"
 
-# Configurations: sim_std.ini / sim_hoc.ini, fr1_std.ini / fr1_hoc.ini (hoc_configs.sh).
-source "$SRC/tests/benchmarks/hoc/hoc_configs.sh"
+# Configurations: sim_std.ini / sim_hoc.ini, fr1_std.ini / fr1_hoc.ini.
 write_hoc_configs "$SRC" "$OUT"
 
 generate() {  # scene [seed]

@@ -9,14 +9,10 @@
 #   moving_camera_dynamic"). Sequences already in OUT_DIR are reused.
 # Writes OUT_DIR/seed_sweep.md: TE std / HOC [mm] per seed and the medians, final maps std / HOC.
 set -euo pipefail
-SRC="$(cd "$(dirname "$0")/../../.." && pwd)"
-BUILD="$(cd "${1:-$SRC/build}" && pwd)"
-OUT="${2:-$SRC/out/hoc_seeds}"
+source "$(dirname "${BASH_SOURCE[0]}")/hoc_configs.sh"
+hoc_dirs out/hoc_seeds "$@"
 SEEDS="${SEEDS:-5 7 11 13 17 23 29}"
 SCENES="${SCENES:-static_camera_crowd moving_camera_dynamic}"
-BIN="$BUILD/bin"
-mkdir -p "$OUT"
-source "$SRC/tests/benchmarks/hoc/hoc_configs.sh"
 write_hoc_configs "$SRC" "$OUT"
 
 for scene in $SCENES; do

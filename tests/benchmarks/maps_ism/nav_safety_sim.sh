@@ -31,8 +31,7 @@
 # A keygrid-slam that does not know the key (before the height-band grid) rejects it; the script then
 # runs "paper" without the key (that grid IS the paper's model) and reports the other models n/a.
 set -uo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../../.." && pwd)"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 build="$root/build"
 out=/tmp/keygrid_nav_safety
 scenes="room_loop room_survey corridor_loop office_loop relocalization"
@@ -42,30 +41,15 @@ maxFrames=0
 simFrames=0
 extraSet=""
 runTag=""
-die() { echo "nav_safety_sim.sh: error: $*" >&2; exit 2; }
-while [ $# -gt 0 ]; do
-  [ $# -ge 2 ] || { [ "$1" = --help ] || [ "$1" = -h ] || die "missing value after $1"; }
-  case "$1" in
-    --build) build="$2" ;;
-    --out) out="$2" ;;
-    --scenes) scenes="$2" ;;
-    --models) models="$2" ;;
-    --inputs) inputs="$2" ;;
-    --max-frames) maxFrames="$2" ;;
-    --sim-frames) simFrames="$2" ;;
-    --set) extraSet="$2" ;;
-    --tag) runTag="_$2" ;;
-    --help|-h) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
-    *) die "unknown argument $1 (see --help)" ;;
-  esac
-  shift 2
-done
-[[ "$maxFrames" =~ ^[0-9]+$ ]] || die "--max-frames must be a whole number, got '$maxFrames'"
-[[ "$simFrames" =~ ^[0-9]+$ ]] || die "--sim-frames must be a whole number, got '$simFrames'"
+kg_parse_args --build=build --out=out --scenes=scenes --models=models --inputs=inputs --max-frames=maxFrames \
+  --sim-frames=simFrames --set=extraSet --tag=runTag -- "$@"
+[ -z "$runTag" ] || runTag="_$runTag"
+kg_whole_number --max-frames "$maxFrames"
+kg_whole_number --sim-frames "$simFrames"
 for m in $models; do [ "$m" = heightBand ] || [ "$m" = paper ] || die "--models: unknown model '$m' (heightBand | paper)"; done
 for i in $inputs; do [ "$i" = sparse ] || [ "$i" = dense ] || die "--inputs: unknown input '$i' (sparse | dense)"; done
+build="$(kg_build_dir "$build" keygrid-sim keygrid-slam keygrid-eval)" || exit 2
 bin="$build/bin"
-for t in keygrid-sim keygrid-slam keygrid-eval; do [ -x "$bin/$t" ] || die "$bin/$t not found (build it, or pass --build)"; done
 for s in $scenes; do [ -f "$root/config/sim/$s.ini" ] || die "--scenes: no scene config/sim/$s.ini"; done
 mkdir -p "$out"
 

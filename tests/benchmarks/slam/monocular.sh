@@ -19,31 +19,13 @@
 #   tests/benchmarks/slam/monocular.sh [--build DIR] [--out DIR] [--cases "room office fr1 desk"] [--help]
 # Results: doc/evaluation.md, "Monocular mode".
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../../.." && pwd)"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 build="$root/build"
 out=/tmp/keygrid_monocular
 cases="room office fr1 desk"
 data="$root/../shared/data"
-usage() { sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; }
-die() { echo "monocular.sh: error: $*" >&2; exit 2; }
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --help|-h) usage; exit 0 ;;
-  esac
-  [ $# -ge 2 ] || die "missing value after $1 (see --help)"
-  case "$1" in
-    --build) build="$2" ;;
-    --out) out="$2" ;;
-    --cases) cases="$2" ;;
-    *) die "unknown argument '$1' (see --help)" ;;
-  esac
-  shift 2
-done
-build="$(cd "$build" 2>/dev/null && pwd)" || die "no build folder $build"
-for t in keygrid-sim keygrid-slam keygrid-eval; do
-  [ -x "$build/bin/$t" ] || die "$build/bin/$t not found (build it, or pass --build)"
-done
+kg_parse_args --build=build --out=out --cases=cases -- "$@"
+build="$(kg_build_dir "$build" keygrid-sim keygrid-slam keygrid-eval)" || exit 2
 mkdir -p "$out" || die "cannot create $out"
 
 # render NAME SCENE -> $out/sim/NAME (once)

@@ -32,8 +32,7 @@
 #   --map              also record the run into a session file (keygrid-slam --map RUN/session.kgmap)
 #   --header           print the table header before the row
 set -uo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../../.." && pwd)"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 build="$root/build"
 out=/tmp/keygrid_office_memory
 sim=""
@@ -42,28 +41,10 @@ tag=""
 maxFrames=0
 header=0
 withMap=0
-die() { echo "office_loop_memory.sh: error: $*" >&2; exit 2; }
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --help|-h) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
-    --header) header=1; shift; continue ;;
-    --map) withMap=1; shift; continue ;;
-  esac
-  [ $# -ge 2 ] || die "missing value after $1"
-  case "$1" in
-    --build) build="$2" ;;
-    --out) out="$2" ;;
-    --sim) sim="$2" ;;
-    --set) extraSet="$2" ;;
-    --tag) tag="$2" ;;
-    --max-frames) maxFrames="$2" ;;
-    *) die "unknown argument $1 (see --help)" ;;
-  esac
-  shift 2
-done
-[[ "$maxFrames" =~ ^[0-9]+$ ]] || die "--max-frames must be a whole number, got '$maxFrames'"
-build="$(cd "$build" 2>/dev/null && pwd)" || die "no build folder $build"
-[ -x "$build/bin/keygrid-slam" ] || die "$build/bin/keygrid-slam not found (build it, or pass --build)"
+kg_parse_args --build=build --out=out --sim=sim --set=extraSet --tag=tag --max-frames=maxFrames \
+  --header=header:1 --map=withMap:1 -- "$@"
+kg_whole_number --max-frames "$maxFrames"
+build="$(kg_build_dir "$build" keygrid-slam)" || exit 2
 [ -n "$tag" ] || tag="$(basename "$(dirname "$build")")_$(basename "$build")"
 mkdir -p "$out" || die "cannot create $out"
 

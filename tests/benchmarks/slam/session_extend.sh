@@ -19,30 +19,17 @@
 #               when missing (default: OUT/sim)
 # Results: doc/evaluation.md, "Map sessions".
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../../.." && pwd)"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 build="$root/build"
 out=""
 sim=""
 cases="corridor room office"
-usage() { sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; }
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build) build="$2"; shift 2 ;;
-    --out) out="$2"; shift 2 ;;
-    --sim) sim="$2"; shift 2 ;;
-    --cases) cases="$2"; shift 2 ;;
-    --help|-h) usage; exit 0 ;;
-    *) echo "session_extend.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
-  esac
-done
+kg_parse_args --build=build --out=out --sim=sim --cases=cases -- "$@"
+build="$(kg_build_dir "$build" keygrid-sim keygrid-slam keygrid-eval)" || exit 2
 [ -n "$out" ] || out="$(mktemp -d)"
 [ -n "$sim" ] || sim="$out/sim"
 mkdir -p "$out" "$sim"
 bin="$build/bin"
-for t in keygrid-sim keygrid-slam keygrid-eval; do
-  [ -x "$bin/$t" ] || { echo "session_extend.sh: $bin/$t not found (build it, or pass --build)" >&2; exit 2; }
-done
 
 # run_case NAME SCENE MAP_FROM MAP_FRAMES EXTEND_FROM EXTEND_FRAMES (0: to the end)
 run_case() {
@@ -87,6 +74,6 @@ for c in $cases; do
     corridor) run_case corridor corridor_loop 0 450 600 0 ;;
     room) run_case room room_loop 0 150 250 0 ;;
     office) run_case office office_loop 1650 1650 400 1500 ;;
-    *) echo "session_extend.sh: unknown case '$c' (corridor, room, office)" >&2; exit 2 ;;
+    *) die "unknown case '$c' (corridor, room, office)" ;;
   esac
 done

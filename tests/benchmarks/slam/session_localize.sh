@@ -12,28 +12,16 @@
 #   tests/benchmarks/slam/session_localize.sh [--build DIR] [--out DIR] [--cases "sim fr1"] [--help]
 # Results: doc/evaluation.md, "Map sessions".
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../../.." && pwd)"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 build="$root/build"
 out=""
 cases="sim fr1"
 data="$root/../shared/data"
-usage() { sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; }
-while [ $# -gt 0 ]; do
-  case "$1" in
-    --build) build="$2"; shift 2 ;;
-    --out) out="$2"; shift 2 ;;
-    --cases) cases="$2"; shift 2 ;;
-    --help|-h) usage; exit 0 ;;
-    *) echo "session_localize.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
-  esac
-done
+kg_parse_args --build=build --out=out --cases=cases -- "$@"
+build="$(kg_build_dir "$build" keygrid-sim keygrid-slam keygrid-eval keygrid-map)" || exit 2
 [ -n "$out" ] || out="$(mktemp -d)"
 mkdir -p "$out"
 bin="$build/bin"
-for t in keygrid-sim keygrid-slam keygrid-eval keygrid-map; do
-  [ -x "$bin/$t" ] || { echo "session_localize.sh: $bin/$t not found (build it, or pass --build)" >&2; exit 2; }
-done
 
 # case NAME CONFIG MAP_INPUT MAP_GT MAP_ARGS LOC_INPUT LOC_GT LOC_ARGS
 run_case() {
@@ -78,7 +66,7 @@ for c in $cases; do
       if [ ! -f "$seq/groundtruth.txt" ]; then echo "fr1  | skipped: $seq not found"; continue; fi
       run_case fr1 "$root/config/tum_fr1.ini" "$seq" "$seq/groundtruth.txt" "--max-frames 150" \
         "$seq" "$seq/groundtruth.txt" "--first-frame 150" ;;
-    *) echo "session_localize.sh: unknown case '$c' (sim, fr1)" >&2; exit 2 ;;
+    *) die "unknown case '$c' (sim, fr1)" ;;
   esac
 done
 echo "outputs in $out"
