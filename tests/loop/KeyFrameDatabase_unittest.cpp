@@ -18,6 +18,20 @@ BowVector randomBow(std::mt19937_64& rng, WordId vocabSize, int n)
 	normaliseL1(v);
 	return v;
 }
+
+/** Adds `count` random vectors (randomBow(rng, vocabSize, words)) to `db` as keyframes
+ * firstId, firstId + 1, ...; returns them in that order. */
+std::vector<BowVector> addRandomKeyFrames(
+	KeyFrameDatabase& db, std::mt19937_64& rng, int count, KeyFrameId firstId, WordId vocabSize, int words)
+{
+	std::vector<BowVector> stored;
+	for (int i = 0; i < count; ++i)
+	{
+		stored.push_back(randomBow(rng, vocabSize, words));
+		db.add(firstId + static_cast<KeyFrameId>(i), stored.back());
+	}
+	return stored;
+}
 }  // namespace
 
 TEST(BowVector, L1ScoreClosedForms)
@@ -41,12 +55,7 @@ TEST(KeyFrameDatabase, QueryMatchesBruteForceScoresAndRanking)
 {
 	std::mt19937_64 rng(5);
 	KeyFrameDatabase db;
-	std::vector<BowVector> stored;
-	for (int i = 0; i < 200; ++i)
-	{
-		stored.push_back(randomBow(rng, 500, 60));
-		db.add(static_cast<KeyFrameId>(1000 + i), stored.back());
-	}
+	const std::vector<BowVector> stored = addRandomKeyFrames(db, rng, 200, 1000, 500, 60);
 	const BowVector q = randomBow(rng, 500, 60);
 	DatabaseQuery opt;
 	opt.maxResults = 0;
@@ -67,12 +76,7 @@ TEST(KeyFrameDatabase, ReturnsTheRightKeyFrameAndHonoursOptions)
 {
 	std::mt19937_64 rng(6);
 	KeyFrameDatabase db;
-	std::vector<BowVector> stored;
-	for (int i = 0; i < 50; ++i)
-	{
-		stored.push_back(randomBow(rng, 2000, 80));
-		db.add(static_cast<KeyFrameId>(i), stored.back());
-	}
+	const std::vector<BowVector> stored = addRandomKeyFrames(db, rng, 50, 0, 2000, 80);
 	// The query: keyframe 17's vector with perturbed weights and 20 % of words replaced.
 	BowVector q = stored[17];
 	std::uniform_real_distribution<double> jitter(0.8, 1.2);

@@ -3,6 +3,7 @@
  * Descriptor sets with known structure for the loop tests: clusters around random centres
  * (binary: bit flips, float: Gaussian noise) and "images" drawn from a pool of prototypes.
  */
+#include <keygrid/loop/Vocabulary.h>
 #include <opencv2/core.hpp>
 
 #include <cstdint>
@@ -18,6 +19,18 @@ inline cv::Mat randomBinary(int rows, int bytes, std::mt19937_64& rng)
 	for (int r = 0; r < rows; ++r)
 		for (int c = 0; c < bytes; ++c) m.at<uchar>(r, c) = static_cast<uchar>(byte(rng));
 	return m;
+}
+
+/** A vocabulary (`branching` x `levels`, other options default) trained on `images` "images" of
+ * `rows` random binary descriptors each, drawn from `rng`. */
+inline loop::Vocabulary randomBinaryVocabulary(int images, int rows, int branching, int levels, std::mt19937_64& rng)
+{
+	std::vector<cv::Mat> imgs;
+	for (int i = 0; i < images; ++i) imgs.push_back(randomBinary(rows, 32, rng));
+	loop::VocabularyOptions o;
+	o.branching = branching;
+	o.levels = levels;
+	return loop::Vocabulary::train(imgs, o);
 }
 
 /** Copy of `d` with `flips` random bits flipped per row. */

@@ -15,6 +15,7 @@ using namespace keygrid::loop;
 using keygrid::test::addNoise;
 using keygrid::test::flipBits;
 using keygrid::test::randomBinary;
+using keygrid::test::randomBinaryVocabulary;
 using keygrid::test::sampleImage;
 
 namespace
@@ -219,12 +220,7 @@ TEST(Vocabulary, NoisyCopyOfAnImageRanksFirstAmongDistractors)
 TEST(Vocabulary, DirectIndexGroupsFeaturesByNodeAtTheRequestedLevel)
 {
 	std::mt19937_64 rng(4);
-	std::vector<cv::Mat> imgs;
-	for (int i = 0; i < 5; ++i) imgs.push_back(randomBinary(400, 32, rng));
-	VocabularyOptions o;
-	o.branching = 6;
-	o.levels = 3;
-	const Vocabulary v = Vocabulary::train(imgs, o);
+	const Vocabulary v = randomBinaryVocabulary(5, 400, 6, 3, rng);
 	const cv::Mat q = randomBinary(300, 32, rng);
 	FeatureVector fv;
 	const BowVector a = v.transform(q, fv, 2);
@@ -325,12 +321,7 @@ TEST(VocabularyOptions, ConfigRoundTripAndInvalidKey)
 TEST(DirectIndexMatcher, RecoversAPermutationOfNoisyDescriptors)
 {
 	std::mt19937_64 rng(31);
-	std::vector<cv::Mat> imgs;
-	for (int i = 0; i < 5; ++i) imgs.push_back(randomBinary(400, 32, rng));
-	VocabularyOptions o;
-	o.branching = 8;
-	o.levels = 3;
-	const Vocabulary v = Vocabulary::train(imgs, o);
+	const Vocabulary v = randomBinaryVocabulary(5, 400, 8, 3, rng);
 	// B = A shuffled, 5 bits flipped per descriptor, plus 100 unrelated descriptors.
 	const cv::Mat A = randomBinary(300, 32, rng);
 	std::vector<int> perm(300);

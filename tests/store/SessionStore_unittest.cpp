@@ -138,14 +138,7 @@ TEST(SessionStore, RoundTripOfEveryRecord)
 	for (KeyFrameId id = 0; id < 3; id++)
 		for (int k = 0; k < 5; k++) expectSameLandmark(test::syntheticLandmark(id * 1000 + k, id, 1 + k), lms[n++]);
 
-	const auto covis = store.loadCovisibility();
-	ASSERT_EQ(covis.size(), 2u);
-	EXPECT_EQ(covis[0].a, 0u);
-	EXPECT_EQ(covis[0].b, 1u);
-	EXPECT_EQ(covis[0].weight, 41);
-	EXPECT_EQ(covis[1].a, 1u);
-	EXPECT_EQ(covis[1].b, 2u);
-	EXPECT_EQ(covis[1].weight, 42);
+	test::expectSameCovisibility(store.loadCovisibility(), {{0, 1, 41}, {1, 2, 42}});
 
 	const auto loops = store.loadLoopConstraints();
 	ASSERT_EQ(loops.size(), 1u);

@@ -16,6 +16,33 @@
 using namespace keygrid;
 using namespace keygrid::store;
 
+namespace
+{
+/** `images` "images" of `rows` uniformly random 32-byte descriptors, image i filled by
+ * cv::RNG(firstSeed + i). */
+std::vector<cv::Mat> randomDescriptorImages(int images, int rows, int firstSeed)
+{
+	std::vector<cv::Mat> out;
+	for (int i = 0; i < images; i++)
+	{
+		cv::Mat d(rows, 32, CV_8U);
+		cv::RNG(static_cast<std::uint64_t>(firstSeed + i)).fill(d, cv::RNG::UNIFORM, 0, 256);
+		out.push_back(d);
+	}
+	return out;
+}
+
+/** Single-threaded training options of a small `branching` x 2 tree. */
+loop::VocabularyOptions smallTreeOptions(int branching)
+{
+	loop::VocabularyOptions o;
+	o.branching = branching;
+	o.levels = 2;
+	o.threads = 1;
+	return o;
+}
+}  // namespace
+
 TEST(SparseMapRecords, KeyFramesAndLandmarksThroughTheStore)
 {
 	const auto rec = test::syntheticKeyFrame(12, 300);
@@ -57,31 +84,15 @@ TEST(SparseMapRecords, KeyFramesAndLandmarksThroughTheStore)
 	EXPECT_EQ(lmBack.hoc.count(7), lms[0].hocCounts[7]);
 	EXPECT_TRUE(test::sameMat(lmBack.descriptor, lm.descriptor));
 
-	const auto edges = store.loadCovisibility();
-	ASSERT_EQ(edges.size(), 2u);
-	EXPECT_EQ(edges[0].a, 3u);
-	EXPECT_EQ(edges[0].b, 12u);
-	EXPECT_EQ(edges[0].weight, 40);
-	EXPECT_EQ(edges[1].a, 12u);
-	EXPECT_EQ(edges[1].b, 20u);
-	EXPECT_EQ(edges[1].weight, 17);
+	test::expectSameCovisibility(store.loadCovisibility(), {{3, 12, 40}, {12, 20, 17}});
 }
 
 TEST(VocabularyFingerprint, FileAndObjectGiveTheSameIdentity)
 {
 	EXPECT_EQ(fnv1a64Hex("", 0), "cbf29ce484222325");
 	EXPECT_EQ(fnv1a64Hex("a", 1), "af63dc4c8601ec8c");
-	std::vector<cv::Mat> images;
-	for (int i = 0; i < 4; i++)
-	{
-		cv::Mat d(200, 32, CV_8U);
-		cv::RNG(i + 1).fill(d, cv::RNG::UNIFORM, 0, 256);
-		images.push_back(d);
-	}
-	loop::VocabularyOptions o;
-	o.branching = 4;
-	o.levels = 2;
-	o.threads = 1;
+	const std::vector<cv::Mat> images = randomDescriptorImages(4, 200, 1);
+	loop::VocabularyOptions o = smallTreeOptions(4);
 	const auto voc = loop::Vocabulary::train(images, o);
 	const std::string path = test::scratchDir("store_vocab") + "/small_voc.bin";
 	voc.save(path);
@@ -98,18 +109,7 @@ TEST(VocabularyFingerprint, FileAndObjectGiveTheSameIdentity)
 
 TEST(VocabularyFingerprint, AVocabularyStoredInTheSessionComesBackWithItsIdentity)
 {
-	std::vector<cv::Mat> images;
-	for (int i = 0; i < 3; i++)
-	{
-		cv::Mat d(150, 32, CV_8U);
-		cv::RNG(10 + i).fill(d, cv::RNG::UNIFORM, 0, 256);
-		images.push_back(d);
-	}
-	loop::VocabularyOptions o;
-	o.branching = 3;
-	o.levels = 2;
-	o.threads = 1;
-	const auto voc = loop::Vocabulary::train(images, o);
+	const auto voc = loop::Vocabulary::train(randomDescriptorImages(3, 150, 10), smallTreeOptions(3));
 	const std::string path = test::scratchDir("store_vocab_blob") + "/s.kgmap";
 	{
 		auto store = SessionStore::Create(path, SessionMeta{});

@@ -84,4 +84,18 @@ inline void expectSameLandmark(const store::LandmarkRecord& a, const store::Land
 	EXPECT_EQ(a.hocCounts, b.hocCounts);
 }
 
+/** `edges` are `expected`, in the same order. */
+inline void expectSameCovisibility(
+	const std::vector<store::CovisibilityEdge>& edges, const std::vector<store::CovisibilityEdge>& expected)
+{
+	ASSERT_EQ(edges.size(), expected.size());
+	for (std::size_t i = 0; i < edges.size(); i++)
+	{
+		SCOPED_TRACE("covisibility edge " + std::to_string(i));
+		EXPECT_EQ(edges[i].a, expected[i].a);
+		EXPECT_EQ(edges[i].b, expected[i].b);
+		EXPECT_EQ(edges[i].weight, expected[i].weight);
+	}
+}
+
 }  // namespace keygrid::test

@@ -96,6 +96,21 @@ void BM_RebuildAfterCorrection(benchmark::State& state)
 	state.counters["keyframes"] = n;
 }
 BENCHMARK(BM_RebuildAfterCorrection)->RangeMultiplier(4)->Range(16, 1024)->Unit(benchmark::kMillisecond);
+/** The peers' timed loop: one OctoMap (3D, 5 cm) inserting cloud i (world frame) from the origin of
+ * pose T[i], i cycling over the poses, 4.5 m maximum range. */
+void insertIntoOctoMap(
+	benchmark::State& state, const std::vector<mrpt::poses::CPose3D>& T, const std::vector<octomap::Pointcloud>& clouds)
+{
+	octomap::OcTree tree(0.05);
+	size_t k = 0;
+	for (auto _ : state)
+	{
+		const size_t i = k++ % T.size();
+		const auto o = T[i].translation();
+		tree.insertPointCloud(clouds[i], octomap::point3d(static_cast<float>(o.x), static_cast<float>(o.y), static_cast<float>(o.z)), 4.5);
+	}
+}
+
 /** Peer in the same run: OctoMap (3D, 5 cm) inserting the same sparse keyframe points. */
 void BM_Peer_OctoMapSparse(benchmark::State& state)
 {
@@ -106,14 +121,7 @@ void BM_Peer_OctoMapSparse(benchmark::State& state)
 	for (size_t i = 0; i < T.size(); i++)
 		for (const auto& p : room.samplePoints(T[i], static_cast<size_t>(state.range(0)), 0.01, rng))
 			clouds[i].push_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
-	octomap::OcTree tree(0.05);
-	size_t k = 0;
-	for (auto _ : state)
-	{
-		const size_t i = k++ % T.size();
-		const auto o = T[i].translation();
-		tree.insertPointCloud(clouds[i], octomap::point3d(static_cast<float>(o.x), static_cast<float>(o.y), static_cast<float>(o.z)), 4.5);
-	}
+	insertIntoOctoMap(state, T, clouds);
 	state.SetItemsProcessed(static_cast<int64_t>(state.iterations()) * state.range(0));
 }
 BENCHMARK(BM_Peer_OctoMapSparse)->Arg(500)->Unit(benchmark::kMicrosecond);
@@ -130,14 +138,7 @@ void BM_Peer_OctoMapDense640x480(benchmark::State& state)
 			const auto w = T[i].composePoint(mrpt::math::TPoint3D(p.x, p.y, p.z));
 			clouds[i].push_back(static_cast<float>(w.x), static_cast<float>(w.y), static_cast<float>(w.z));
 		}
-	octomap::OcTree tree(0.05);
-	size_t k = 0;
-	for (auto _ : state)
-	{
-		const size_t i = k++ % T.size();
-		const auto o = T[i].translation();
-		tree.insertPointCloud(clouds[i], octomap::point3d(static_cast<float>(o.x), static_cast<float>(o.y), static_cast<float>(o.z)), 4.5);
-	}
+	insertIntoOctoMap(state, T, clouds);
 }
 BENCHMARK(BM_Peer_OctoMapDense640x480)->Arg(1)->Arg(4)->Unit(benchmark::kMillisecond);
 }  // namespace
