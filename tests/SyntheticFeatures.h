@@ -34,6 +34,24 @@ inline cv::Mat randomDescriptors(int n, std::mt19937& rng)
 	return d;
 }
 
+/** `n` points spread over the image of `cam` placed at the world's origin (its optical frame is
+ * the world frame), at least `marginPx` pixels inside the borders, at depths uniform in
+ * [minDepth, maxDepth] m. */
+inline SyntheticPoints pointsInView(
+	const core::RgbdCamera& cam, std::mt19937& rng, int n, double marginPx, double minDepth, double maxDepth)
+{
+	SyntheticPoints w;
+	std::uniform_real_distribution<double> u(marginPx, cam.width - marginPx), v(marginPx, cam.height - marginPx),
+		z(minDepth, maxDepth);
+	for (int i = 0; i < n; i++)
+	{
+		const double d = z(rng);
+		w.p_world.emplace_back((u(rng) - cam.cx) / cam.fx * d, (v(rng) - cam.cy) / cam.fy * d, d);
+	}
+	w.descriptors = randomDescriptors(n, rng);
+	return w;
+}
+
 /** `n` points on the inside of a vertical cylinder about the world's y axis (radius [m],
  * heights in [-halfHeight, halfHeight]), at random azimuths: a textured wall all around. */
 inline SyntheticPoints cylinderWall(std::mt19937& rng, double radius, double halfHeight, int n)

@@ -11,6 +11,8 @@
 #include <cmath>
 #include <random>
 
+#include "CameraPoses.h"
+
 using namespace keygrid::maps;
 using mrpt::math::TPoint3D;
 using mrpt::math::TPoint3Df;
@@ -27,6 +29,8 @@ struct Room
 	CPose3D T_world_level;
 	/** Keyframe camera poses in the world (optical frames). */
 	std::vector<CPose3D> T_world_cams;
+	/** Per keyframe, its depth samples in its camera frame. */
+	std::vector<std::vector<TPoint3Df>> samples_cam;
 };
 
 /** An optical camera at `eye` (level frame) looking at `at`. */
@@ -35,26 +39,14 @@ CPose3D lookAt(const TPoint3D& eye, const TPoint3D& at)
 	const TVector3D f = TVector3D(at.x - eye.x, at.y - eye.y, at.z - eye.z) * (1.0 / (at - eye).norm());
 	TVector3D x = mrpt::math::crossProduct3D(f, TVector3D(0, 0, 1));
 	x *= 1.0 / x.norm();
-	const TVector3D y = mrpt::math::crossProduct3D(f, x);
-	mrpt::math::CMatrixDouble33 R;
-	for (int i = 0; i < 3; i++)
-	{
-		R(i, 0) = x[i];
-		R(i, 1) = y[i];
-		R(i, 2) = f[i];
-	}
-	mrpt::math::CVectorFixedDouble<3> t;
-	t[0] = eye.x;
-	t[1] = eye.y;
-	t[2] = eye.z;
-	return CPose3D::FromRotationAndTranslation(R, t);
+	return keygrid::test::opticalPose(x, mrpt::math::crossProduct3D(f, x), f, eye);
 }
 
 /** 10 keyframes at 1.3 m, looking 20 deg down towards the wall x = 6 (a hand-held camera),
  * and per keyframe 2000 samples (level frame) with sigma = 5 mm noise along z: 2 % floor (a
  * 0.3 m strip at the foot of the wall), 15 % table top (0.75 m, 1.6 x 1.2 m), 10 % sofa seat
  * (0.45 m, 2 x 0.8 m), the rest on the walls x = 6 and y = 0, y = 5. */
-Room makeRoom(std::vector<std::vector<TPoint3Df>>& samples_cam)
+Room makeRoom()
 {
 	Room room;
 	std::vector<CPose3D> T_level_cams;
@@ -85,7 +77,7 @@ Room makeRoom(std::vector<std::vector<TPoint3Df>>& samples_cam)
 			const TPoint3D c = T_level_cam.inverseComposePoint(p);
 			s.emplace_back(static_cast<float>(c.x), static_cast<float>(c.y), static_cast<float>(c.z));
 		}
-		samples_cam.push_back(std::move(s));
+		room.samples_cam.push_back(std::move(s));
 		room.T_world_cams.push_back(room.T_world_level + T_level_cam);
 	}
 	return room;
@@ -103,14 +95,19 @@ std::pair<double, double> floorError(const CPose3D& T_world_floor, const Room& r
 	const double z = T_level_floor.z() - (nx * (at.x - T_level_floor.x()) + ny * (at.y - T_level_floor.y())) / nz;
 	return {z, tilt};
 }
+
+/** Every keyframe of `room`, in order, added to `est`. */
+void addRoomKeyframes(FloorFrameEstimator& est, const Room& room)
+{
+	for (std::size_t k = 0; k < room.T_world_cams.size(); k++) est.addKeyframe(k, room.T_world_cams[k], room.samples_cam[k]);
+}
 }  // namespace
 
 TEST(FloorFrameEstimator, FindsAFloorOf2PercentUnderLargerTableAndSofaTops)
 {
-	std::vector<std::vector<TPoint3Df>> samples;
-	const Room room = makeRoom(samples);
+	const Room room = makeRoom();
 	FloorFrameEstimator est;
-	for (std::size_t k = 0; k < samples.size(); k++) est.addKeyframe(k, room.T_world_cams[k], samples[k]);
+	addRoomKeyframes(est, room);
 	ASSERT_TRUE(est.T_world_floor());
 	ASSERT_FALSE(est.history().empty());
 	// The first keyframes see the floor beyond the table: from the third on, it is found
@@ -141,13 +138,12 @@ TEST(FloorFrameEstimator, TheLargestLowPlaneOfTheOldSequentialRansacIsNotTheFloo
 	// The same samples through estimateFloorPlane (the ISM grid's standalone estimator, which
 	// takes the lowest of the largest planes): on this room the estimate is not the floor,
 	// which is what the lowest-plane search with the "points below" test fixes.
-	std::vector<std::vector<TPoint3Df>> samples;
-	const Room room = makeRoom(samples);
+	const Room room = makeRoom();
 	std::vector<TPoint3D> pts;
 	TVector3D up(0, 0, 0);
-	for (std::size_t k = 0; k < samples.size(); k++)
+	for (std::size_t k = 0; k < room.samples_cam.size(); k++)
 	{
-		for (const auto& p : samples[k]) pts.push_back(room.T_world_cams[k].composePoint(TPoint3D(p.x, p.y, p.z)));
+		for (const auto& p : room.samples_cam[k]) pts.push_back(room.T_world_cams[k].composePoint(TPoint3D(p.x, p.y, p.z)));
 		up = up + room.T_world_cams[k].rotateVector(TVector3D(0, -1, 0));
 	}
 	const auto plane = estimateFloorPlane(pts, up, room.T_world_cams[0].translation(), FloorPlaneRansacOptions());
@@ -158,15 +154,14 @@ TEST(FloorFrameEstimator, TheLargestLowPlaneOfTheOldSequentialRansacIsNotTheFloo
 
 TEST(FloorFrameEstimator, FollowsCorrectedPosesAndKeepsTheGivenFrame)
 {
-	std::vector<std::vector<TPoint3Df>> samples;
-	const Room room = makeRoom(samples);
+	const Room room = makeRoom();
 	FloorFrameEstimator est;
-	for (std::size_t k = 0; k < samples.size(); k++) est.addKeyframe(k, room.T_world_cams[k], samples[k]);
+	addRoomKeyframes(est, room);
 	ASSERT_TRUE(est.T_world_floor());
 	// The whole trajectory re-anchored by G: the floor frame follows, G * T_world_floor.
 	const CPose3D G(0.3, -0.2, 0.1, 0.4, -0.1, 0.2);
 	std::map<uint64_t, CPose3D> moved;
-	for (std::size_t k = 0; k < samples.size(); k++) moved[k] = G + room.T_world_cams[k];
+	for (std::size_t k = 0; k < room.samples_cam.size(); k++) moved[k] = G + room.T_world_cams[k];
 	const CPose3D expected = G + *est.T_world_floor();
 	EXPECT_TRUE(est.updatePoses(moved));
 	// (Up to the RANSAC's inlier sets at the band edges, which round-off may change.)
@@ -179,7 +174,7 @@ TEST(FloorFrameEstimator, FollowsCorrectedPosesAndKeepsTheGivenFrame)
 	FloorFrameEstimator given(o);
 	ASSERT_TRUE(given.T_world_floor());
 	EXPECT_TRUE(given.given());
-	EXPECT_FALSE(given.addKeyframe(0, room.T_world_cams[0], samples[0]));
+	EXPECT_FALSE(given.addKeyframe(0, room.T_world_cams[0], room.samples_cam[0]));
 	EXPECT_NEAR(given.T_world_floor()->yaw(), 10 * M_PI / 180, 1e-9);
 	EXPECT_NEAR(given.T_world_floor()->z(), 3.0, 1e-12);
 	EXPECT_TRUE(given.history().empty());
@@ -188,14 +183,13 @@ TEST(FloorFrameEstimator, FollowsCorrectedPosesAndKeepsTheGivenFrame)
 
 TEST(FloorFrameEstimator, ReservoirIsBoundedAndScheduleIsPeriodic)
 {
-	std::vector<std::vector<TPoint3Df>> samples;
-	const Room room = makeRoom(samples);
+	const Room room = makeRoom();
 	FloorFrameOptions o;
 	o.reservoirSize = 5000;
 	o.initialKeyframes = 3;
 	o.reestimateEvery = 4;
 	FloorFrameEstimator est(o);
-	for (std::size_t k = 0; k < 30; k++) est.addKeyframe(k, room.T_world_cams[k % 10], samples[k % 10]);
+	for (std::size_t k = 0; k < 30; k++) est.addKeyframe(k, room.T_world_cams[k % 10], room.samples_cam[k % 10]);
 	EXPECT_EQ(est.samples(), 5000u);
 	EXPECT_EQ(est.keyframes(), 30u);
 	// Keyframes 1, 2, 3, then 7, 11, ..., 27: 3 + 6 estimates.

@@ -1,9 +1,11 @@
 #pragma once
 /** \file Grid3DTestScenes.h
  * Synthetic depth images for the 3D grid tests, rendered analytically (ray / plane and
- * ray / box intersections), so the expected voxels follow from closed forms.
+ * ray / box intersections), so the expected voxels follow from closed forms; and the small
+ * submapped grid of a wall that the conflict, morphing and I/O tests start from.
  */
 #include <keygrid/core/RgbdCamera.h>
+#include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <mrpt/poses/CPose3D.h>
 #include <opencv2/core/mat.hpp>
 
@@ -57,6 +59,28 @@ inline cv::Mat boxRoomDepth(const core::RgbdCamera& c, const mrpt::poses::CPose3
 			d.at<float>(static_cast<int>(v), static_cast<int>(u)) = static_cast<float>(tExit);
 		}
 	return d;
+}
+
+/** A 5 cm submapped grid that opens a submap on a conflict of 100 voxels, changed by
+ * `configure(map)`, then given two keyframes (ids 1, 2; travelled 0 and 0.1 m) at the origin
+ * of a wall 2.02 m ahead (smallCamera): with the default options its voxels become confidently
+ * occupied (2 hits = 1.7 >= 1.5). */
+template <class Configure>
+CSubmappedOccupancyGrid3D mapOfWall(Configure&& configure)
+{
+	CSubmappedOccupancyGrid3D m(0.05);
+	m.insertionOptions.conflict.conflictMinVoxels = 100;
+	configure(m);
+	const auto cam = smallCamera();
+	m.insertDepthFrame(wallDepth(cam, 2.02f), cam, mrpt::poses::CPose3D(), 0.0, 1);
+	m.insertDepthFrame(wallDepth(cam, 2.02f), cam, mrpt::poses::CPose3D(), 0.1, 2);
+	return m;
+}
+
+/** mapOfWall with the default options. */
+inline CSubmappedOccupancyGrid3D mapOfWall()
+{
+	return mapOfWall([](CSubmappedOccupancyGrid3D&) {});
 }
 
 }  // namespace keygrid::test

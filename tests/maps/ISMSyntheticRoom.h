@@ -11,6 +11,8 @@
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/poses/CPose3D.h>
 
+#include "CameraPoses.h"
+
 #include <cmath>
 #include <limits>
 #include <random>
@@ -33,22 +35,7 @@ struct SyntheticRoom
 	/** Optical camera at (x, y, h) in the level frame, yaw theta, pitched down by `pitch`. */
 	mrpt::poses::CPose3D cameraPose(double x, double y, double h, double yaw, double pitch) const
 	{
-		const mrpt::math::TVector3D fwd(std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), -std::sin(pitch));
-		const mrpt::math::TVector3D right(std::sin(yaw), -std::cos(yaw), 0);
-		const mrpt::math::TVector3D down(
-			fwd.y * right.z - fwd.z * right.y, fwd.z * right.x - fwd.x * right.z, fwd.x * right.y - fwd.y * right.x);
-		mrpt::math::CMatrixDouble33 R;
-		for (int i = 0; i < 3; i++)
-		{
-			R(i, 0) = right[i];
-			R(i, 1) = down[i];
-			R(i, 2) = fwd[i];
-		}
-		mrpt::math::CVectorFixedDouble<3> t;
-		t[0] = x;
-		t[1] = y;
-		t[2] = h;
-		return T_world_level + mrpt::poses::CPose3D::FromRotationAndTranslation(R, t);
+		return T_world_level + levelOpticalPose(x, y, h, yaw, pitch);
 	}
 
 	/** Depth along the optical axis of the first surface hit by the ray through normalised

@@ -17,29 +17,31 @@ using keygrid::CellState;
 
 namespace
 {
-/** Rows of characters, the first string is cy = 0 (lowest y), 1 m cells from (0, 0).
- * Plan: 'O' occupied, '.' free. Estimate: 'O' occupied, 'F' free, '?' unknown. */
-FloorPlanGrid plan(const std::vector<std::string>& rows)
+/** A grid drawn as rows of characters, the first string is cy = 0 (lowest y), 1 m cells from
+ * (0, 0); `cellOf` turns a character into the grid's cell value. */
+template <class Grid, class CellOf>
+Grid gridFromRows(const std::vector<std::string>& rows, CellOf cellOf)
 {
-	FloorPlanGrid g;
+	Grid g;
 	g.resolution = 1.0;
 	g.sizeX = static_cast<int>(rows[0].size());
 	g.sizeY = static_cast<int>(rows.size());
 	for (const auto& r : rows)
-		for (const char c : r) g.cells.push_back(c == 'O' ? FloorPlanGrid::Occupied : FloorPlanGrid::Free);
+		for (const char c : r) g.cells.push_back(cellOf(c));
 	return g;
 }
 
+/** Plan: 'O' occupied, '.' free. */
+FloorPlanGrid plan(const std::vector<std::string>& rows)
+{
+	return gridFromRows<FloorPlanGrid>(rows, [](char c) { return c == 'O' ? FloorPlanGrid::Occupied : FloorPlanGrid::Free; });
+}
+
+/** Estimate: 'O' occupied, 'F' free, '?' unknown. */
 TriStateGrid estimate(const std::vector<std::string>& rows)
 {
-	TriStateGrid g;
-	g.resolution = 1.0;
-	g.sizeX = static_cast<int>(rows[0].size());
-	g.sizeY = static_cast<int>(rows.size());
-	for (const auto& r : rows)
-		for (const char c : r)
-			g.cells.push_back(c == 'O' ? CellState::Occupied : c == 'F' ? CellState::Free : CellState::Unknown);
-	return g;
+	return gridFromRows<TriStateGrid>(
+		rows, [](char c) { return c == 'O' ? CellState::Occupied : c == 'F' ? CellState::Free : CellState::Unknown; });
 }
 
 // A 4 x 3 obstacle (x 2..5, y 1..3): 12 cells, 2 interior ((3,2), (4,2): no free cell among

@@ -7,21 +7,7 @@
 
 using namespace keygrid;
 using mrpt::poses::CPose3D;
-
-namespace
-{
-/** Two keyframes (ids 1, 2) of a wall 2.02 m ahead from the origin: its voxels become
- * confidently occupied (2 hits = 1.7 >= 1.5). */
-CSubmappedOccupancyGrid3D mapOfWall()
-{
-	CSubmappedOccupancyGrid3D m(0.05);
-	m.insertionOptions.conflict.conflictMinVoxels = 100;
-	const auto cam = test::smallCamera();
-	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(), 0.0, 1);
-	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(), 0.1, 2);
-	return m;
-}
-}  // namespace
+using test::mapOfWall;
 
 TEST(SubmappedConflict, VoxelsRememberTheTravelledDistanceOfTheirLastUpdate)
 {

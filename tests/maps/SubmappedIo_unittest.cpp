@@ -31,17 +31,15 @@ namespace
 /** A map with two submaps (a forced conflict), stored depth and non-default options. */
 CSubmappedOccupancyGrid3D twoSubmapMap()
 {
-	CSubmappedOccupancyGrid3D m(0.05);
-	m.insertionOptions.conflict.conflictMinVoxels = 100;
-	m.insertionOptions.storeKeyframeDepth = true;
-	m.insertionOptions.integration.logOddsHit = 0.9f;
-	m.morphingOptions.weightExponent = 3.0;
-	m.morphingOptions.interpolation = MorphingOptions::Interpolation::Nearest;
-	m.morphingOptions.maxKeyframesPerBlock = 12;
-	m.likelihoodOptions.decimation = 7;
+	auto m = test::mapOfWall([](CSubmappedOccupancyGrid3D& g) {
+		g.insertionOptions.storeKeyframeDepth = true;
+		g.insertionOptions.integration.logOddsHit = 0.9f;
+		g.morphingOptions.weightExponent = 3.0;
+		g.morphingOptions.interpolation = MorphingOptions::Interpolation::Nearest;
+		g.morphingOptions.maxKeyframesPerBlock = 12;
+		g.likelihoodOptions.decimation = 7;
+	});
 	const auto cam = test::smallCamera();
-	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(), 0.0, 1);
-	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(), 0.1, 2);
 	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(0, 0, 0.5, 0.1, 0, 0), 5.0, 3);
 	return m;
 }

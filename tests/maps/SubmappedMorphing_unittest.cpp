@@ -128,11 +128,8 @@ TEST(SubmappedMorphing, RigidRotationMovesTheGridWithinAVoxel)
 
 TEST(SubmappedMorphing, ConflictSubmapsMergeIntoOneConsistentGrid)
 {
-	CSubmappedOccupancyGrid3D m(0.05);
-	m.insertionOptions.conflict.conflictMinVoxels = 100;
+	auto m = test::mapOfWall();
 	const auto cam = test::smallCamera();
-	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(), 0.0, 1);
-	m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, CPose3D(), 0.1, 2);
 	const CPose3D drifted(0, 0, 0.5, 0, 0, 0);
 	ASSERT_TRUE(m.insertDepthFrame(test::wallDepth(cam, 2.02f), cam, drifted, 5.0, 3).conflict);
 	ASSERT_EQ(m.numSubmaps(), 2u);

@@ -12,17 +12,10 @@ using mrpt::poses::CPose3D;
 
 namespace
 {
+/** `n` points over the first camera's image, 20 px inside its borders, at depths in [2, 5] m. */
 test::SyntheticPoints pointsInView(const core::RgbdCamera& cam, std::mt19937& rng, int n)
 {
-	test::SyntheticPoints w;
-	std::uniform_real_distribution<double> u(20, cam.width - 20), v(20, cam.height - 20), z(2.0, 5.0);
-	for (int i = 0; i < n; i++)
-	{
-		const double d = z(rng);
-		w.p_world.emplace_back((u(rng) - cam.cx) / cam.fx * d, (v(rng) - cam.cy) / cam.fy * d, d);
-	}
-	w.descriptors = test::randomDescriptors(n, rng);
-	return w;
+	return test::pointsInView(cam, rng, n, 20, 2.0, 5.0);
 }
 
 /** The keypoints of `f` moved by (du, dv) pixels that stay inside the image (grid rebuilt);

@@ -22,15 +22,7 @@ constexpr int kWorldPoints = 600;
 /** Points spread over the first camera's image at depths in [2, 5] m. */
 test::SyntheticPoints makeWorld(const core::RgbdCamera& cam, std::mt19937& rng)
 {
-	test::SyntheticPoints w;
-	std::uniform_real_distribution<double> u(10, cam.width - 10), v(10, cam.height - 10), z(2.0, 5.0);
-	for (int i = 0; i < kWorldPoints; i++)
-	{
-		const double d = z(rng);
-		w.p_world.emplace_back((u(rng) - cam.cx) / cam.fx * d, (v(rng) - cam.cy) / cam.fy * d, d);
-	}
-	w.descriptors = test::randomDescriptors(kWorldPoints, rng);
-	return w;
+	return test::pointsInView(cam, rng, kWorldPoints, 10, 2.0, 5.0);
 }
 
 /** An image-only frame and its features (no depth anywhere). */

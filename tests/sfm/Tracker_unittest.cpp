@@ -23,15 +23,7 @@ constexpr int kFrames = 10;
  * [kMinDepth, kMaxDepth]. */
 test::SyntheticPoints makeWorld(const core::RgbdCamera& cam, std::mt19937& rng)
 {
-	test::SyntheticPoints w;
-	std::uniform_real_distribution<double> u(10, cam.width - 10), v(10, cam.height - 10), z(kMinDepth, kMaxDepth);
-	for (int i = 0; i < kWorldPoints; i++)
-	{
-		const double d = z(rng);
-		w.p_world.emplace_back((u(rng) - cam.cx) / cam.fx * d, (v(rng) - cam.cy) / cam.fy * d, d);
-	}
-	w.descriptors = test::randomDescriptors(kWorldPoints, rng);
-	return w;
+	return test::pointsInView(cam, rng, kWorldPoints, 10, kMinDepth, kMaxDepth);
 }
 
 /** The camera of frame i on a smooth path from the identity: about 2 cm and 0.4 deg a frame. */

@@ -256,30 +256,35 @@ void expectAccurate(const Scene& s, const TwoViewResult& r, TwoViewModel model)
 	EXPECT_EQ(r.numTriangulated, static_cast<int>(std::count(r.triangulated.begin(), r.triangulated.end(), uint8_t{1})));
 	EXPECT_GE(r.parallaxDeg, TwoViewOptions{}.minParallaxDeg);
 }
+
+/** The scene with translation `t` (planar or not) of seeds 1, 2, 3 through the initializer: each
+ * result must pass expectAccurate for `model`, and `whySelected(r)` checks the model choice. */
+template <class WhySelected>
+void expectRecoveredOverSeeds(const Eigen::Vector3d& t, bool planar, TwoViewModel model, WhySelected whySelected)
+{
+	for (uint32_t seed : {1u, 2u, 3u})
+	{
+		SCOPED_TRACE(seed);
+		const Scene s = makeScene(kR, t, planar, kPoints, kOutlierShare, seed);
+		const TwoViewResult r = TwoViewInitializer(kK).initialize(s.matches);
+		expectAccurate(s, r, model);
+		whySelected(r);
+	}
+}
 }  // namespace
 
 TEST(TwoViewInitializer, GeneralSceneSelectsFundamentalAndRecoversTheMotion)
 {
-	for (uint32_t seed : {1u, 2u, 3u})
-	{
-		SCOPED_TRACE(seed);
-		const Scene s = makeScene(kR, kGeneralT, false, kPoints, kOutlierShare, seed);
-		const TwoViewResult r = TwoViewInitializer(kK).initialize(s.matches);
-		expectAccurate(s, r, TwoViewModel::Fundamental);
+	expectRecoveredOverSeeds(kGeneralT, false, TwoViewModel::Fundamental, [](const TwoViewResult& r) {
 		EXPECT_LT(r.ratioH, TwoViewOptions{}.homographyRatio);
-	}
+	});
 }
 
 TEST(TwoViewInitializer, PlanarSceneSelectsHomographyAndRecoversTheMotion)
 {
-	for (uint32_t seed : {1u, 2u, 3u})
-	{
-		SCOPED_TRACE(seed);
-		const Scene s = makeScene(kR, kPlanarT, true, kPoints, kOutlierShare, seed);
-		const TwoViewResult r = TwoViewInitializer(kK).initialize(s.matches);
-		expectAccurate(s, r, TwoViewModel::Homography);
+	expectRecoveredOverSeeds(kPlanarT, true, TwoViewModel::Homography, [](const TwoViewResult& r) {
 		EXPECT_GE(r.sharedInlierShare, TwoViewOptions{}.homographyInlierShare);
-	}
+	});
 }
 
 TEST(TwoViewInitializer, PureRotationIsRefusedAsLowParallax)

@@ -17,14 +17,9 @@ TEST(LoopClosure, GeneratedRoomLoopIsClosed)
 	// The room loop compressed to 10 s (0.66 m/s, 38 deg/s): the camera returns to its start.
 	const auto run = test::renderAndRunSlam(
 		test::scratchDir("loop_room"), "--frames 300 --scene " + test::sourceDir() + "/config/sim/room_loop.ini", true);
-	ASSERT_TRUE(run.rendered) << run.simLog;
-	const auto& o = run.options;
-	const auto& r = run.result;
-	EXPECT_TRUE(r.error.empty()) << r.error;
-	EXPECT_EQ(r.tracked, 300u);
-	ASSERT_TRUE(r.ateRmse.has_value());
 	// 1 cm: the target of the synthetic loops with loop closing (doc/evaluation.md, Summary).
-	EXPECT_LT(*r.ateRmse, 0.01);
+	ASSERT_NO_FATAL_FAILURE(test::expectCentimetreRun(run, 300));
+	const auto& o = run.options;
 	const std::string js = test::readTextFile(o.output + "/report.json");
 	const auto report = nlohmann::json::parse(js);
 	ASSERT_FALSE(report["loop_closures"].empty()) << js;
@@ -62,10 +57,7 @@ TEST(LoopClosure, GeneratedRoomLoopIsClosed)
 	ot.output = o.output + "_threaded";
 	ot.modeOverride = slam::RunMode::Threaded;
 	const auto rt = slam::runSlam(ot);
-	EXPECT_TRUE(rt.error.empty()) << rt.error;
-	EXPECT_EQ(rt.tracked, 300u);
-	ASSERT_TRUE(rt.ateRmse.has_value());
-	EXPECT_LT(*rt.ateRmse, 0.01);
+	ASSERT_NO_FATAL_FAILURE(test::expectCentimetreRun(rt, 300));
 	const std::string jt = test::readTextFile(ot.output + "/report.json");
 	const auto reportT = nlohmann::json::parse(jt);
 	ASSERT_FALSE(reportT["loop_closures"].empty()) << jt;

@@ -36,4 +36,22 @@ inline SimSlamRun renderAndRunSlam(
 	run.result = slam::runSlam(run.options);
 	return run;
 }
+
+/** The synthetic sequences' target with exact ground truth (doc/evaluation.md, Summary): the
+ * run ended without error, tracked all of its `frames` frames and its ATE is under 1 cm. */
+inline void expectCentimetreRun(const slam::SlamRunResult& r, std::size_t frames)
+{
+	EXPECT_TRUE(r.error.empty()) << r.error;
+	EXPECT_EQ(r.frames, frames);
+	EXPECT_EQ(r.tracked, frames);
+	ASSERT_TRUE(r.ateRmse.has_value());
+	EXPECT_LT(*r.ateRmse, 0.01);
+}
+
+/** expectCentimetreRun after checking that keygrid-sim rendered the sequence. */
+inline void expectCentimetreRun(const SimSlamRun& run, std::size_t frames)
+{
+	ASSERT_TRUE(run.rendered) << run.simLog;
+	expectCentimetreRun(run.result, frames);
+}
 }  // namespace keygrid::test
