@@ -62,17 +62,29 @@ Clustered makeClusters(bool binary, int clusters, int perCluster, std::uint64_t 
 	return c;
 }
 
-/** word -> set of cluster labels of its members, and cluster -> set of words. */
-void wordsAndClusters(
-	const Vocabulary& v, const Clustered& c, std::map<WordId, std::set<int>>& labelsOfWord,
-	std::map<int, std::set<WordId>>& wordsOfCluster)
+/** A vocabulary trained on the images of clusters, and how its words split them. */
+struct ClusterWords
 {
+	Vocabulary v;
+	std::map<WordId, std::set<int>> labelsOfWord;    //!< word -> cluster labels of its members
+	std::map<int, std::set<WordId>> wordsOfCluster;  //!< cluster -> its members' words
+};
+
+/** `makeClusters(binary, clusters, perCluster, seed)` through a `branching` x `levels` tree. */
+ClusterWords trainOnClusters(bool binary, int clusters, int perCluster, std::uint64_t seed, int branching, int levels)
+{
+	const Clustered c = makeClusters(binary, clusters, perCluster, seed);
+	VocabularyOptions o;
+	o.branching = branching;
+	o.levels = levels;
+	ClusterWords t{Vocabulary::train(c.images, o), {}, {}};
 	for (int r = 0; r < c.all.rows; ++r)
 	{
-		const WordId w = v.wordOf(c.all.row(r));
-		labelsOfWord[w].insert(c.label[static_cast<std::size_t>(r)]);
-		wordsOfCluster[c.label[static_cast<std::size_t>(r)]].insert(w);
+		const WordId w = t.v.wordOf(c.all.row(r));
+		t.labelsOfWord[w].insert(c.label[static_cast<std::size_t>(r)]);
+		t.wordsOfCluster[c.label[static_cast<std::size_t>(r)]].insert(w);
 	}
+	return t;
 }
 }  // namespace
 
@@ -83,16 +95,9 @@ class VocabularyClusters : public ::testing::TestWithParam<bool>
 TEST_P(VocabularyClusters, OneLevelTreeRecoversTheClusters)
 {
 	const bool binary = GetParam();
-	const auto c = makeClusters(binary, 8, 40, 7);
-	VocabularyOptions o;
-	o.branching = 8;
-	o.levels = 1;
-	const Vocabulary v = Vocabulary::train(c.images, o);
+	const auto [v, labelsOfWord, wordsOfCluster] = trainOnClusters(binary, 8, 40, 7, 8, 1);
 	EXPECT_EQ(v.numWords(), 8u);
 	EXPECT_EQ(v.descriptorType(), binary ? DescriptorType::Binary : DescriptorType::Float);
-	std::map<WordId, std::set<int>> labelsOfWord;
-	std::map<int, std::set<WordId>> wordsOfCluster;
-	wordsAndClusters(v, c, labelsOfWord, wordsOfCluster);
 	// A bijection: every cluster is exactly one word and every word exactly one cluster.
 	ASSERT_EQ(wordsOfCluster.size(), 8u);
 	for (const auto& [k, words] : wordsOfCluster) EXPECT_EQ(words.size(), 1u) << "cluster " << k;
@@ -103,15 +108,7 @@ TEST_P(VocabularyClusters, DeeperTreeKeepsEveryWordPure)
 {
 	// 27 clusters with k = 4, L = 3 (64 leaves): level 1 sees groups of clusters; every leaf
 	// must still hold the members of one cluster only.
-	const bool binary = GetParam();
-	const auto c = makeClusters(binary, 27, 20, 11);
-	VocabularyOptions o;
-	o.branching = 4;
-	o.levels = 3;
-	const Vocabulary v = Vocabulary::train(c.images, o);
-	std::map<WordId, std::set<int>> labelsOfWord;
-	std::map<int, std::set<WordId>> wordsOfCluster;
-	wordsAndClusters(v, c, labelsOfWord, wordsOfCluster);
+	const auto [v, labelsOfWord, wordsOfCluster] = trainOnClusters(GetParam(), 27, 20, 11, 4, 3);
 	std::size_t mixed = 0;
 	for (const auto& [w, labels] : labelsOfWord) mixed += labels.size() > 1;
 	EXPECT_EQ(mixed, 0u);

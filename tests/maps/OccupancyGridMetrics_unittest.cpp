@@ -72,6 +72,18 @@ OccupancyMetricsOptions oneCell()
 	o.matchTolerance = 1.0;  // one 1 m cell: the 4-neighbourhood
 	return o;
 }
+
+/** The recalls over what was in view, counted by hand: `boundary` obstacle boundary cells seen,
+ * `matched` of them matched; `free` free cells seen, `calledFree` of them called free. */
+void expectSeenRecalls(const OccupancyMetrics& m, std::size_t boundary, std::size_t matched, std::size_t free, std::size_t calledFree)
+{
+	EXPECT_EQ(m.gtBoundarySeen, boundary);
+	EXPECT_EQ(m.gtBoundarySeenMatched, matched);
+	EXPECT_DOUBLE_EQ(m.boundaryRecall, static_cast<double>(matched) / static_cast<double>(boundary));
+	EXPECT_EQ(m.gtFreeSeen, free);
+	EXPECT_EQ(m.gtFreeSeenCalledFree, calledFree);
+	EXPECT_DOUBLE_EQ(m.freeRecall, static_cast<double>(calledFree) / static_cast<double>(free));
+}
 }  // namespace
 
 TEST(OccupancyGridMetrics, NavigationSafetyCountedByHand)
@@ -83,10 +95,9 @@ TEST(OccupancyGridMetrics, NavigationSafetyCountedByHand)
 	EXPECT_EQ(m.gtOccupiedCalledFree, 3u);  // (3,2), (4,1), (5,3)
 	// Every obstacle cell but (5,1) has an estimated occupied cell within one cell.
 	EXPECT_EQ(m.gtOccupiedMatched, 11u);
-	// Boundary = the 10 non-interior cells, all in view without a mask; 9 matched.
-	EXPECT_EQ(m.gtBoundarySeen, 10u);
-	EXPECT_EQ(m.gtBoundarySeenMatched, 9u);
-	EXPECT_DOUBLE_EQ(m.boundaryRecall, 0.9);
+	// Boundary = the 10 non-interior cells, all in view without a mask; 9 matched. Without a
+	// mask every one of the 36 GT-free cells counts; 28 are called free.
+	expectSeenRecalls(m, 10, 9, 36, 28);
 	// Estimated occupied: 5 on the obstacle + (1,4).
 	EXPECT_EQ(m.estOccupied, 6u);
 	EXPECT_EQ(m.estOccupiedMatched, 5u);
@@ -94,11 +105,7 @@ TEST(OccupancyGridMetrics, NavigationSafetyCountedByHand)
 	// Estimated free: rows 7 + 4 + 4 + 3 + 6 + 7 = 31, of which 3 on the obstacle.
 	EXPECT_EQ(m.estFree, 31u);
 	EXPECT_EQ(m.estFreeCorrect, 28u);
-	// Without a mask every one of the 36 GT-free cells counts; 28 are called free.
-	EXPECT_EQ(m.gtFreeSeen, 36u);
-	EXPECT_EQ(m.gtFreeSeenCalledFree, 28u);
 	EXPECT_DOUBLE_EQ(m.freePrecision, 28.0 / 31.0);
-	EXPECT_DOUBLE_EQ(m.freeRecall, 28.0 / 36.0);
 	// Harmonic mean of 28/31 and 28/36 = 2 * 28 / (31 + 36).
 	EXPECT_NEAR(m.freeF1, 56.0 / 67.0, 1e-12);
 	// The existing free accuracy: 29 GT-free cells observed (36 - 7 unknown), 28 correct.
@@ -139,12 +146,7 @@ TEST(OccupancyGridMetrics, VisibilityMaskRestrictsRecallNotPrecision)
 	see(3, 2, FloorPlanGrid::SeenFreeSpace);
 	see(0, 5, FloorPlanGrid::SeenSurface);
 	const auto m = evaluateOccupancy(estimate(kEst), gt, oneCell());
-	EXPECT_EQ(m.gtBoundarySeen, 4u);
-	EXPECT_EQ(m.gtBoundarySeenMatched, 3u);
-	EXPECT_DOUBLE_EQ(m.boundaryRecall, 0.75);
-	EXPECT_EQ(m.gtFreeSeen, 16u);
-	EXPECT_EQ(m.gtFreeSeenCalledFree, 13u);
-	EXPECT_DOUBLE_EQ(m.freeRecall, 13.0 / 16.0);
+	expectSeenRecalls(m, 4, 3, 16, 13);
 	const double p = 28.0 / 31.0, r = 13.0 / 16.0;
 	EXPECT_NEAR(m.freeF1, 2 * p * r / (p + r), 1e-12);
 	// Unchanged by the mask: hazards, precision, the all-cells recall.

@@ -8,10 +8,10 @@ source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 hoc_dirs() {
 	local defaultOut="$1"
 	shift
-	case "${1:-}" in --help|-h) kg_usage; exit 0 ;; esac
+	kg_help "$@"
 	[ $# -le 2 ] || die "at most two arguments, BUILD_DIR and OUT_DIR (see --help)"
 	SRC="$root"
-	BUILD="$(kg_build_dir "${1:-$SRC/build}" keygrid-slam)" || exit 2
+	BUILD="$(kg_build_dir "${1:-$build}" keygrid-slam)" || exit 2
 	BIN="$BUILD/bin"
 	OUT="${2:-$SRC/$defaultOut}"
 	mkdir -p "$OUT" || die "cannot create $OUT"

@@ -3,17 +3,23 @@
 #
 #   source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 #
-# Sets `root` (the source tree) and `kg_name` (the calling script's file name, for messages).
-# A script's help text is its header comment: from line 2 to the line before its `set -` line.
+# Sets `root` (the source tree), `build` (the default build folder, root/build) and `kg_name`
+# (the calling script's file name, for messages). A script's help text is its header comment:
+# from line 2 to the line before its `set -` line.
 
 kg_name="$(basename "$0")"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../../.." && pwd)"
+build="$root/build"
 
 # die MESSAGE...: "SCRIPT: error: MESSAGE" on stderr, exit status 2.
 die() { echo "$kg_name: error: $*" >&2; exit 2; }
 
 # kg_usage: the calling script's header comment without its leading '# '.
 kg_usage() { sed -n '2,/^set -/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
+
+# kg_help "$@": for the scripts with positional arguments: a first argument --help / -h prints
+# kg_usage and exits 0.
+kg_help() { case "${1:-}" in --help|-h) kg_usage; exit 0 ;; esac; }
 
 # kg_parse_args SPEC... -- ARGS...: parses ARGS into the caller's variables. A SPEC is
 # OPTION=VARIABLE for an option followed by a value (`--out=out`: `--out DIR` sets $out) or
@@ -55,7 +61,7 @@ kg_build_dir() {
   dir="$(cd "$1" 2>/dev/null && pwd)" || die "no build folder $1"
   shift
   for t in "$@"; do
-    [ -x "$dir/bin/$t" ] || die "$dir/bin/$t not found (build it, or pass --build)"
+    [ -x "$dir/bin/$t" ] || die "$dir/bin/$t not found (build it, or name another build folder)"
   done
   echo "$dir"
 }

@@ -10,9 +10,9 @@
 # Needs the targets keygrid-sim keygrid-slam keygrid_floor_estimate_eval
 # (KEYGRID_BUILD_BENCHMARKS=ON). Results: doc/evaluation.md, "Floor frame".
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../../.." && pwd)"
-build="${1:-$root/build}"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
+kg_help "$@"
+build="$(kg_build_dir "${1:-$build}" keygrid-sim keygrid-slam keygrid_floor_estimate_eval)" || exit 2
 out="${2:-$(mktemp -d)}"
 cfg="$(realpath "${3:-$root/config/sim.ini}")"
 mkdir -p "$out"

@@ -8,9 +8,9 @@
 # Needs the targets keygrid-sim keygrid-slam keygrid_ism2d_sim_eval (KEYGRID_BUILD_BENCHMARKS=ON).
 # Results and their discussion: doc/maps-ism2d.md.
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../../.." && pwd)"
-build="${1:-$root/build}"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
+kg_help "$@"
+build="$(kg_build_dir "${1:-$build}" keygrid-sim keygrid-slam keygrid_ism2d_sim_eval)" || exit 2
 out="${2:-$(mktemp -d)}"
 every="${3:-10}"
 scene="$(realpath "${4:-$root/config/sim/room_survey.ini}")"

@@ -32,7 +32,6 @@
 # runs "paper" without the key (that grid IS the paper's model) and reports the other models n/a.
 set -uo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
-build="$root/build"
 out=/tmp/keygrid_nav_safety
 scenes="room_loop room_survey corridor_loop office_loop relocalization"
 models="heightBand paper"

@@ -5,9 +5,9 @@
 # Reference (ORB-SLAM2 RGB-D, TUM1.yaml, same 250 frames, 2-core machine, see issue 4):
 #   ATE 2.60 cm median of 3 runs, 250/250 tracked, tracking 15.5 ms median per frame.
 set -euo pipefail
-here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-root="$(cd "$here/../../.." && pwd)"
-build="${1:-$root/build}"
+source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
+kg_help "$@"
+build="$(kg_build_dir "${1:-$build}" keygrid-slam)" || exit 2
 runs="${2:-3}"
 data="${KEYGRID_SHARED_DATA:-$root/../shared/data}/tum_fr1_rpy_first250"
 [ -d "$data" ] || { echo "missing $data" >&2; exit 2; }

@@ -20,7 +20,6 @@
 # Results: doc/evaluation.md, "Monocular mode".
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
-build="$root/build"
 out=/tmp/keygrid_monocular
 cases="room office fr1 desk"
 data="$root/../shared/data"

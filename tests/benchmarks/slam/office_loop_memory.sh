@@ -33,7 +33,6 @@
 #   --header           print the table header before the row
 set -uo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
-build="$root/build"
 out=/tmp/keygrid_office_memory
 sim=""
 extraSet=""

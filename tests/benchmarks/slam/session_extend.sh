@@ -20,7 +20,6 @@
 # Results: doc/evaluation.md, "Map sessions".
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
-build="$root/build"
 out=""
 sim=""
 cases="corridor room office"

@@ -13,7 +13,6 @@
 # Results: doc/evaluation.md, "Map sessions".
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
-build="$root/build"
 out=""
 cases="sim fr1"
 data="$root/../shared/data"
