@@ -2,13 +2,11 @@
 # (SCRIPT [BUILD_DIR=build] [OUT_DIR]).
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 
-# Usage: hoc_dirs DEFAULT_OUT [BUILD_DIR [OUT_DIR]]: --help / -h prints the script's header
-# comment; sets SRC (the source tree), BUILD (checked to hold bin/keygrid-slam), BIN = BUILD/bin and
+# Usage: hoc_dirs DEFAULT_OUT [BUILD_DIR [OUT_DIR]]: sets SRC (the source tree), BUILD (checked to hold bin/keygrid-slam), BIN = BUILD/bin and
 # OUT (OUT_DIR or SRC/DEFAULT_OUT, created).
 hoc_dirs() {
 	local defaultOut="$1"
 	shift
-	kg_help "$@"
 	[ $# -le 2 ] || die "at most two arguments, BUILD_DIR and OUT_DIR (see --help)"
 	SRC="$root"
 	BUILD="$(kg_build_dir "${1:-$build}" keygrid-slam)" || exit 2

@@ -5,7 +5,9 @@
 #
 # Sets `root` (the source tree), `build` (the default build folder, root/build) and `kg_name`
 # (the calling script's file name, for messages). A script's help text is its header comment:
-# from line 2 to the line before its `set -` line.
+# from line 2 to the line before its `set -` line; a script whose first argument is --help / -h
+# prints it and exits 0 here, when it sources this file (sourced without arguments, this file
+# sees the script's).
 
 kg_name="$(basename "$0")"
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../../.." && pwd)"
@@ -17,9 +19,8 @@ die() { echo "$kg_name: error: $*" >&2; exit 2; }
 # kg_usage: the calling script's header comment without its leading '# '.
 kg_usage() { sed -n '2,/^set -/p' "$0" | sed '$d; s/^# \{0,1\}//'; }
 
-# kg_help "$@": for the scripts with positional arguments: a first argument --help / -h prints
-# kg_usage and exits 0.
-kg_help() { case "${1:-}" in --help|-h) kg_usage; exit 0 ;; esac; }
+# The script's arguments: a first --help / -h prints the help text.
+case "${1:-}" in --help|-h) kg_usage; exit 0 ;; esac
 
 # kg_parse_args SPEC... -- ARGS...: parses ARGS into the caller's variables. A SPEC is
 # OPTION=VARIABLE for an option followed by a value (`--out=out`: `--out DIR` sets $out) or

@@ -11,7 +11,6 @@
 # (KEYGRID_BUILD_BENCHMARKS=ON). Results: doc/evaluation.md, "Floor frame".
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
-kg_help "$@"
 build="$(kg_build_dir "${1:-$build}" keygrid-sim keygrid-slam keygrid_floor_estimate_eval)" || exit 2
 out="${2:-$(mktemp -d)}"
 cfg="$(realpath "${3:-$root/config/sim.ini}")"

@@ -9,7 +9,6 @@
 # Results and their discussion: doc/maps-ism2d.md.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
-kg_help "$@"
 build="$(kg_build_dir "${1:-$build}" keygrid-sim keygrid-slam keygrid_ism2d_sim_eval)" || exit 2
 out="${2:-$(mktemp -d)}"
 every="${3:-10}"

@@ -6,7 +6,6 @@
 #   ATE 2.60 cm median of 3 runs, 250/250 tracked, tracking 15.5 ms median per frame.
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
-kg_help "$@"
 build="$(kg_build_dir "${1:-$build}" keygrid-slam)" || exit 2
 runs="${2:-3}"
 data="${KEYGRID_SHARED_DATA:-$root/../shared/data}/tum_fr1_rpy_first250"
