@@ -228,3 +228,56 @@ TEST(MetricScale, NeedsACameraHeightAndValidOptions)
 	EXPECT_FALSE(slam::MetricScaleOptions().enabled());
 	EXPECT_TRUE(options().enabled());
 }
+
+// A long run whose scale drifted: along a straight path the keyframes and floor of the first
+// 30 keyframes are metric (cameras camera_height above the floor), those of the newest 20 came
+// out 20 % small. Over the whole map the old stretch outvotes the new one and the estimate
+// keeps the scale (factor 1); along the newest window_path_length of the path it is the scale
+// where the camera is, camera_height / (0.8 camera_height) = 1.25, and it rescales the whole map.
+TEST(MetricScale, AfterTheFirstEstimateTheFloorIsSearchedAlongTheNewestStretchOfThePath)
+{
+	constexpr double kDrift = 0.8;
+	constexpr int kMetric = 30, kDrifted = 20;
+	const auto straight = [](double x, double h) { return camera(x, 0, h, 0); };
+	for (const double window : {8.0, 0.0})
+	{
+		SCOPED_TRACE(window);
+		sfm::SparseMap map;
+		auto o = options();
+		o.windowPathLength = window;
+		o.reestimateEvery = 1;
+		slam::MetricScale scale(o);
+		// Floor points ahead of every other keyframe, seen from it and the next one.
+		std::mt19937 rng(3);
+		std::vector<sfm::KeyFrameId> ids;
+		const auto addStretch = [&](int from, int to, double height)
+		{
+			for (int k = from; k < to; k++) ids.push_back(map.addKeyFrame(keyFrame(straight(0.5 * k, height), 400)).id);
+			for (int k = from; k + 1 < to; k += 2)
+			{
+				std::uniform_real_distribution<double> ux(0.5 * k + 1.0, 0.5 * k + 4.0), uy(-2, 2);
+				for (int i = 0; i < 400; i++) map.addObservation(map.addLandmark({ux(rng), uy(rng), 0.0}, ids[k], i), ids[k + 1], i);
+			}
+		};
+		addStretch(0, kMetric, kCameraHeight);
+		const auto first = scale.update(map);
+		ASSERT_TRUE(first.has_value()) << scale.stats().lastMessage;
+		EXPECT_NEAR(*first, 1.0, 1e-6);
+		addStretch(kMetric, kMetric + kDrifted, kDrift * kCameraHeight);
+		const auto s = scale.update(map);
+		ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+		ASSERT_EQ(scale.log().size(), 2u);
+		if (window > 0)
+		{
+			EXPECT_NEAR(*s, 1.0 / kDrift, 1e-6);
+			EXPECT_NEAR(map.keyframe(ids.back()).T_world_cam.z(), kCameraHeight, 1e-6);
+			// 8 m of path at 0.5 m between keyframes: the newest 17.
+			EXPECT_NE(scale.log()[1].find("keyframe 49, 17 keyframes"), std::string::npos) << scale.log()[1];
+		}
+		else
+		{
+			EXPECT_NEAR(*s, 1.0, 1e-6);
+			EXPECT_NE(scale.log()[1].find("keyframe 49, 50 keyframes"), std::string::npos) << scale.log()[1];
+		}
+	}
+}

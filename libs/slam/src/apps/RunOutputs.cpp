@@ -92,12 +92,11 @@ void writeRunFiles(System& sys, const SlamConfig& cfg, const RunFilesInput& in, 
 		tum("trajectory_online.txt", raw, "keygrid-slam online poses (as tracked)");
 	}
 	out.text("frames.csv", framesCsv(sys));
-	if (!sys.initializationLog().empty())
-	{
-		std::string log;
-		for (const auto& line : sys.initializationLog()) log += "initialization: " + line + "\n";
-		out.text("slam.log", log);
-	}
+	std::string log;
+	for (const auto& line : sys.initializationLog()) log += "initialization: " + line + "\n";
+	if (sys.metricScale())
+		for (const auto& line : sys.metricScale()->log()) log += "metric scale: " + line + "\n";
+	if (!log.empty()) out.text("slam.log", log);
 	tum("keyframes.txt", sys.keyframeTrajectory(), "keygrid-slam keyframes");
 	// A loaded map's keyframes have their images in the session file, not here.
 	if (!sys.localizeOnly())

@@ -4,8 +4,9 @@
  * map has enough keyframes, sfm::CameraHeightScaleEstimator measures its scale (metres per map
  * unit) and the map is rescaled by it; from then on the estimate is repeated every
  * reestimate_every keyframes and applied again, so the map stays metric as it grows and its
- * scale drifts. Until the first estimate succeeds it is tried at every new keyframe. The map
- * alone is rescaled here; the caller (slam::System) moves what refers to it (tracker, frames).
+ * scale drifts. Until the first estimate succeeds it is tried at every new keyframe; later ones
+ * search the floor along the newest stretch of the path (window_path_length). The map alone is
+ * rescaled here; the caller (slam::System) moves what refers to it (tracker, frames).
  */
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/CameraHeightScale.h>
@@ -13,6 +14,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace mrpt::config
 {
@@ -35,6 +37,13 @@ struct MetricScaleOptions
 	 * triangulated over a short baseline (the map start's) may lie far off its surface, under
 	 * the floor; 0 = every point (Default: 2 deg) */
 	double minPointParallaxDeg{2.0};
+	/** Once the map is metric, the floor is searched among the newest keyframes that span this
+	 * much of the path [m] and the map points they observe: a monocular map's scale drifts
+	 * along the path, so its floor is a plane only locally, and over the whole map of a long
+	 * run the floor seen early lies above or under the floor seen late. The factor found there
+	 * rescales the whole map: it is the scale where the camera is now. The first estimate uses
+	 * the whole map (its units are not metres yet); 0 = always the whole map (Default: 8 m) */
+	double windowPathLength{8.0};
 
 	bool enabled() const { return estimator.cameraHeight > 0; }
 	core::OptionFields fields();
@@ -71,6 +80,10 @@ class MetricScale
 		std::string lastMessage;  //!< the last estimate's result text
 	};
 	const Stats& stats() const { return m_stats; }
+	/** One line per estimate run: the newest keyframe id, the keyframes searched, and the
+	 * result (the factor applied, or why none was); the first kMaxLogLines estimates. */
+	const std::vector<std::string>& log() const { return m_log; }
+	static constexpr std::size_t kMaxLogLines = 1000;
 	/** The floor plane of the last applied estimate, n . p + offset = 0 in the map as it is
 	 * now (metres; n unit, towards the cameras); nullopt before the first. */
 	struct FloorPlane
@@ -89,6 +102,7 @@ class MetricScale
 	std::optional<sfm::KeyFrameId> m_lastEstimateAt;
 	Stats m_stats;
 	std::optional<FloorPlane> m_floorPlane;  //!< see floorPlane()
+	std::vector<std::string> m_log;  //!< see log()
 };
 
 }  // namespace keygrid::slam
