@@ -20,8 +20,8 @@
  * In a SLAM run (maps::KeyFrameMap, CHOCPointsMap_keyframes.cpp) the map follows the
  * frontend's landmarks (syncLandmarks) and takes nothing from keyframes or corrections itself.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/maps/ExportFrame.h>
-#include <keygrid/maps/FieldTableOptions.h>
 #include <keygrid/maps/HocGeometry.h>
 #include <keygrid/maps/HocHistogram.h>
 #include <keygrid/maps/KeyFrameMap.h>
@@ -52,7 +52,7 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 	};
 
 	/** insertObservation() of depth scans. INI section `_insertOpts`. */
-	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
+	struct TInsertionOptions : public core::FieldTableOptions<TInsertionOptions>
 	{
 		/** Use every n-th pixel in rows and columns (Default: 8) */
 		int decimation{8};
@@ -68,7 +68,7 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 	/** Likelihood of a depth scan: product over decimated pixels of a Gaussian of the distance
 	 * to the nearest map point (searched in the 27 neighbouring spacing-voxels), floored.
 	 * INI section `_likelihoodOpts`. */
-	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
+	struct TLikelihoodOptions : public core::FieldTableOptions<TLikelihoodOptions>
 	{
 		int decimation{16};  //!< (Default: 16)
 		double sigma{0.05};  //!< [m] (Default: 0.05)

@@ -3,8 +3,8 @@
  * A 2D navigation occupancy grid filled from visual-SLAM keyframes with the erf inverse sensor
  * model of Lu & Wang (2018). MRPT CMetricMap plugin registered as "ismOccupancyGrid2D".
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
-#include <keygrid/maps/FieldTableOptions.h>
 #include <keygrid/maps/FloorPlaneEstimator.h>
 #include <keygrid/maps/InverseSensorModel.h>
 #include <keygrid/maps/KeyFrameMap.h>
@@ -66,7 +66,7 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 
    public:
 	/** Creation options: the grid geometry. */
-	struct TCreationOptions : public maps::FieldTableOptions<TCreationOptions>
+	struct TCreationOptions : public core::FieldTableOptions<TCreationOptions>
 	{
 		/** Cell size [m] (Default: 0.05 m) */
 		double resolution{0.05};
@@ -103,7 +103,7 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	};
 
 	/** Insertion options: ISM, noise, height band, floor frame, traversal, thresholds. */
-	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
+	struct TInsertionOptions : public core::FieldTableOptions<TInsertionOptions>
 	{
 		/** Ideal-model occupancy before the band (Default: 0.30) */
 		double pFree{0.30};
@@ -168,7 +168,7 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	};
 
 	/** Likelihood options for computeObservationLikelihood(CObservation3DRangeScan). */
-	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
+	struct TLikelihoodOptions : public core::FieldTableOptions<TLikelihoodOptions>
 	{
 		/** Use every n-th depth pixel in rows and columns (Default: 8) */
 		int decimation{8};

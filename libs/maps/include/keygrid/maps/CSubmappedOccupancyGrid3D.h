@@ -29,11 +29,11 @@
  * worker threads (options `threads`, `morphThreads`) and give the same result for any count.
  * Documentation and measurements: doc/maps-3d.md.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/ConflictDetector.h>
 #include <keygrid/maps/DepthFrameIntegrator.h>
 #include <keygrid/maps/ExportFrame.h>
-#include <keygrid/maps/FieldTableOptions.h>
 #include <keygrid/maps/GridMorphing.h>
 #include <keygrid/maps/KeyFrameMap.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
@@ -96,7 +96,7 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	};
 
 	/** Options of observation insertion (INI section `..._insertOpts`). */
-	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
+	struct TInsertionOptions : public core::FieldTableOptions<TInsertionOptions>
 	{
 		DepthIntegrationOptions integration;
 		ConflictOptions conflict;
@@ -113,7 +113,7 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	};
 
 	/** Options of computeObservationLikelihood (INI section `..._likelihoodOpts`). */
-	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
+	struct TLikelihoodOptions : public core::FieldTableOptions<TLikelihoodOptions>
 	{
 		/** Use every N-th pixel in u and v (Default: 10) */
 		unsigned decimation{10};
