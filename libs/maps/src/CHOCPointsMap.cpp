@@ -4,7 +4,6 @@
  */
 #include "detail/DepthOfScan.h"
 
-#include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/CHOCPointsMap.h>
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -139,14 +138,11 @@ VoxelIndex indexPoints(const std::vector<CHOCPointsMap::Point>& pts, double s)
 }
 }  // namespace
 
-bool CHOCPointsMap::internal_insertObservation(const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
+bool CHOCPointsMap::insertDepthScan(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam)
 {
-	const auto* scan = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	if (!scan) return false;
 	cv::Mat depth;
 	core::RgbdCamera cam;
-	if (!detail::depthOfScan(*scan, depth, cam)) return false;
-	const mrpt::poses::CPose3D T_world_cam = core::cameraPoseFromSensorPose((robotPose ? *robotPose : mrpt::poses::CPose3D()) + scan->sensorPose);
+	if (!detail::depthOfScan(scan, depth, cam)) return false;
 	const mrpt::poses::CPose3D T_cam_world = -T_world_cam;
 	const Eigen::Vector3d centre(T_world_cam.x(), T_world_cam.y(), T_world_cam.z());
 	const auto& geom = geometry();
@@ -194,18 +190,11 @@ bool CHOCPointsMap::internal_insertObservation(const mrpt::obs::CObservation& ob
 	return true;
 }
 
-bool CHOCPointsMap::internal_canComputeObservationLikelihood(const mrpt::obs::CObservation& obs) const
+double CHOCPointsMap::depthScanLikelihood(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) const
 {
-	return dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs) != nullptr && !m_points.empty();
-}
-
-double CHOCPointsMap::internal_computeObservationLikelihood(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const
-{
-	const auto* scan = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
 	cv::Mat depth;
 	core::RgbdCamera cam;
-	if (!scan || !detail::depthOfScan(*scan, depth, cam) || m_points.empty()) return 0;
-	const mrpt::poses::CPose3D T_world_cam = core::cameraPoseFromSensorPose(takenFrom + scan->sensorPose);
+	if (!detail::depthOfScan(scan, depth, cam) || m_points.empty()) return 0;
 	const double s = std::max(insertionOptions.pointSpacing, 3 * likelihoodOptions.sigma);
 	const auto idx = indexPoints(m_points, s);
 	const double inv2s2 = 1.0 / (2 * likelihoodOptions.sigma * likelihoodOptions.sigma);
