@@ -3,6 +3,7 @@
  * likelihood. Serialization, PLY and visualization are in CHOCPointsMap_io.cpp.
  */
 #include "detail/DepthOfScan.h"
+#include "detail/MapDefinitionSections.h"
 
 #include <keygrid/maps/CHOCPointsMap.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -23,16 +24,12 @@ CHOCPointsMap::TMapDefinition::TMapDefinition() = default;
 void CHOCPointsMap::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& prefix)
 {
-	hocOpts.loadFromConfigFile(source, prefix + "_creationOpts");
-	insertionOpts.loadFromConfigFile(source, prefix + "_insertOpts");
-	likelihoodOpts.loadFromConfigFile(source, prefix + "_likelihoodOpts");
+	detail::loadMapSections(source, prefix, hocOpts, insertionOpts, likelihoodOpts);
 }
 
 void CHOCPointsMap::TMapDefinition::dumpToTextStream_map_specific(std::ostream& out) const
 {
-	hocOpts.dumpToTextStream(out);
-	insertionOpts.dumpToTextStream(out);
-	likelihoodOpts.dumpToTextStream(out);
+	detail::dumpMapSections(out, hocOpts, insertionOpts, likelihoodOpts);
 }
 
 mrpt::maps::CMetricMap* CHOCPointsMap::internal_CreateFromMapDefinition(const mrpt::maps::TMetricMapInitializer& _def)
