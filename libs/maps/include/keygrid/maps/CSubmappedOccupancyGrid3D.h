@@ -202,6 +202,9 @@ class CSubmappedOccupancyGrid3D : public maps::DepthScanMap, public maps::KeyFra
 	 * recorded when it was integrated (what the grid was built with), not corr's
 	 * T_world_cam_old. Keyframe poses are updated to the new ones. */
 	MorphingStats morphAndMergeSubmaps(const TrajectoryCorrection& corr);
+	/** Keyframe `id`, recorded as `rec`, as morphAndMerge() takes it: from the pose it was
+	 * integrated at to T_world_cam_new. */
+	static MorphKeyframe morphKeyframe(uint64_t id, const KeyframeRecord& rec, const mrpt::poses::CPose3D& T_world_cam_new);
 
 	struct ReintegrationStats
 	{
