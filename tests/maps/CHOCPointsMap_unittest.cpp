@@ -5,13 +5,12 @@
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CHOCPointsMap.h>
 #include <mrpt/config/CConfigFileMemory.h>
-#include <mrpt/io/CMemoryStream.h>
 #include <mrpt/maps/CMultiMetricMap.h>
-#include <mrpt/serialization/CArchive.h>
 
 #include <gtest/gtest.h>
 
 #include "../TestData.h"
+#include "ArchiveRoundTrip.h"
 
 #include <cmath>
 
@@ -100,12 +99,7 @@ TEST(CHOCPointsMap, SerializationRoundTripKeepsPointsDescriptorsAndHistograms)
 		pts.push_back(p);
 	}
 	m.setPoints(pts);
-	mrpt::io::CMemoryStream buf;
-	auto ar = mrpt::serialization::archiveFrom(buf);
-	ar << m;
-	buf.Seek(0);
-	CHOCPointsMap back;
-	ar >> back;
+	const CHOCPointsMap back = keygrid::test::archiveRoundTrip(m);
 	ASSERT_EQ(back.size(), 50u);
 	EXPECT_EQ(back.hocOptions.radii, o.radii);
 	EXPECT_EQ(back.hocOptions.countLimit, 7);

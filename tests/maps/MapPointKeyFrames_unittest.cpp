@@ -6,14 +6,13 @@
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <keygrid/maps/FloorFrameEstimator.h>
 #include <keygrid/maps/KeyFrameMap.h>
-#include <mrpt/io/CMemoryStream.h>
-#include <mrpt/serialization/CArchive.h>
 
 #include <gtest/gtest.h>
 
 #include <random>
 #include <vector>
 
+#include "ArchiveRoundTrip.h"
 #include "Grid3DTestScenes.h"
 #include "ISMSyntheticRoom.h"
 
@@ -220,12 +219,7 @@ TEST(MapPointKeyFrames, A3DGridOfMapPointsFollowsEachKeyFramesScale)
 	ASSERT_EQ(fresh.numSubmaps(), 1u);
 
 	// Serialized and read back before the correction: the stored points come back.
-	mrpt::io::CMemoryStream buf;
-	auto arch = mrpt::serialization::archiveFrom(buf);
-	arch << corrected;
-	buf.Seek(0);
-	CSubmappedOccupancyGrid3D restored;
-	arch >> restored;
+	CSubmappedOccupancyGrid3D restored = keygrid::test::archiveRoundTrip(corrected);
 	ASSERT_EQ(restored.keyframes().size(), run.truth.size());
 	EXPECT_TRUE(restored.builtFromMapPoints());
 

@@ -211,15 +211,8 @@ struct NonRigidCase
 		int i = 0;
 		for (const auto& [id, k] : map.keyframes())
 		{
-			MorphKeyframe mk;
-			mk.id = id;
-			mk.submap = k.submap;
-			mk.travelled = k.travelled;
-			mk.camera = k.camera;
-			mk.T_world_cam_old = k.T_world_cam;
 			const CPose3D corr(0.03 * i, -0.02 * i, 0.017 * i, mrpt::DEG2RAD(1.5 * i), mrpt::DEG2RAD(-0.7 * i), 0);
-			mk.T_world_cam_new = corr + k.T_world_cam;
-			keyframes.push_back(mk);
+			keyframes.push_back(CSubmappedOccupancyGrid3D::morphKeyframe(id, k, corr + k.T_world_cam));
 			++i;
 		}
 	}

@@ -70,11 +70,7 @@ TEST(LoopClosure, GeneratedRoomLoopIsClosed)
 TEST(LoopClosure, NoLoopClaimedOnRealFramesWithoutOne)
 {
 	KEYGRID_SKIP_WITHOUT_SHARED_DATA("tum_fr1_rpy_first250");
-	slam::SlamRunOptions o;
-	o.configPath = test::sourceDir() + "/config/tum_fr1.ini";
-	o.input = test::sharedDataDir() + "/tum_fr1_rpy_first250";
-	o.output = test::scratchDir("loop_rpy");
-	o.quiet = true;
+	const auto o = test::shippedConfigRun("config/tum_fr1.ini", test::sharedDataDir() + "/tum_fr1_rpy_first250", test::scratchDir("loop_rpy"));
 	const auto r = slam::runSlam(o);
 	ASSERT_TRUE(r.error.empty()) << r.error;
 	EXPECT_EQ(r.frames, 250u);

@@ -167,11 +167,7 @@ TEST(MonocularSim, ACameraTurningInPlaceNeverStartsAMapAndSaysWhy)
 							   &simLog),
 			  0)
 		<< simLog;
-	slam::SlamRunOptions o;
-	o.configPath = test::sourceDir() + "/config/sim_monocular.ini";
-	o.input = dir + "/seq/sequence.rawlog";
-	o.output = dir + "/out";
-	o.quiet = true;
+	const auto o = test::shippedConfigRun("config/sim_monocular.ini", dir + "/seq/sequence.rawlog", dir + "/out");
 	const auto r = slam::runSlam(o);
 	ASSERT_TRUE(r.error.empty()) << r.error;
 	EXPECT_EQ(r.frames, 120u);

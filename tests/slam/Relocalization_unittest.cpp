@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "SimSlamRun.h"
 #include "TestData.h"
 
 #include <cstdio>
@@ -54,11 +55,7 @@ TEST(Relocalization, KidnappedCameraIsRelocalizedOnOldKeyframesThroughTheVocabul
 	}
 	core::writeTumTrajectory(dir + "/kidnapped/groundtruth.txt", kidnappedGt);
 
-	slam::SlamRunOptions o;
-	o.configPath = test::sourceDir() + "/config/sim.ini";
-	o.input = dir + "/kidnapped";
-	o.output = dir + "/out";
-	o.quiet = true;
+	const auto o = test::shippedConfigRun("config/sim.ini", dir + "/kidnapped", dir + "/out");
 	const auto r = slam::runSlam(o);
 	EXPECT_TRUE(r.error.empty()) << r.error;
 	ASSERT_EQ(r.frames, order.size());

@@ -1,7 +1,8 @@
 #pragma once
 /** \file SimSlamRun.h
  * The integration tests' common step: keygrid-sim renders a scene into DIR/seq, and
- * keygrid-slam runs a shipped INI (config/sim.ini unless told) on its rawlog into DIR/out. */
+ * keygrid-slam runs a shipped INI (config/sim.ini unless told) on its rawlog into DIR/out;
+ * shippedConfigRun() is that run alone, on any input. */
 #include <keygrid/slam/apps/SlamApp.h>
 
 #include "TestData.h"
@@ -18,6 +19,18 @@ struct SimSlamRun
 	slam::SlamRunResult result;
 };
 
+/** A quiet keygrid-slam run of the shipped INI `config` (relative to the source folder) on
+ * `input` into `output`. */
+inline slam::SlamRunOptions shippedConfigRun(const std::string& config, const std::string& input, const std::string& output)
+{
+	slam::SlamRunOptions o;
+	o.configPath = sourceDir() + "/" + config;
+	o.input = input;
+	o.output = output;
+	o.quiet = true;
+	return o;
+}
+
 /** `simArgs` are keygrid-sim's arguments besides --quiet and --output (e.g. "--scene X.ini
  * --frames 40"); `withGroundTruth` passes DIR/seq/groundtruth.txt as --gt; `config` is the
  * shipped INI to run, relative to the source folder. */
@@ -28,11 +41,8 @@ inline SimSlamRun renderAndRunSlam(
 	run.rendered =
 		runCommand(toolPath("keygrid-sim") + " --quiet " + simArgs + " --output " + dir + "/seq", &run.simLog) == 0;
 	if (!run.rendered) return run;
-	run.options.configPath = sourceDir() + "/" + config;
-	run.options.input = dir + "/seq/sequence.rawlog";
-	run.options.output = dir + "/out";
+	run.options = shippedConfigRun(config, dir + "/seq/sequence.rawlog", dir + "/out");
 	if (withGroundTruth) run.options.groundTruth = dir + "/seq/groundtruth.txt";
-	run.options.quiet = true;
 	run.result = slam::runSlam(run.options);
 	return run;
 }

@@ -93,6 +93,8 @@ TEST(KeyFrameImageCodec, OptionsValidateAndLoad)
 	EXPECT_EQ(q.colourFormat, "jpg");
 	EXPECT_EQ(q.jpegQuality, 80);
 	EXPECT_EQ(q.pngCompression, 1);
-	EXPECT_THROW(KeyFrameImageCodec(ImageCodecOptions{"webp", 1, 95}), std::invalid_argument);
+	ImageCodecOptions webp;
+	webp.colourFormat = "webp";
+	EXPECT_THROW(KeyFrameImageCodec{webp}, std::invalid_argument);
 	EXPECT_THROW(KeyFrameImageCodec().encode(cv::Mat(4, 4, CV_32F), cv::Mat()), std::invalid_argument);
 }

@@ -41,14 +41,6 @@ bool RigidRansacOptions::isValid(std::string* why) const
 	return true;
 }
 
-void RigidRansacOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void RigidRansacOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 namespace
 {
 /** Umeyama fit of dst ~= s R src + t on the listed pairs; returns false when degenerate. */

@@ -37,14 +37,6 @@ void VocabularyOptions::validate(const std::string& section) const
 			" (branching^levels words must be at most 4e9)");
 }
 
-void VocabularyOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void VocabularyOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void Vocabulary::checkDescriptors(const cv::Mat& d) const
 {
 	if (empty()) throw std::logic_error("Vocabulary: empty (train or load it first)");

@@ -3,8 +3,8 @@
  * likelihood. Serialization, PLY and visualization are in CHOCPointsMap_io.cpp.
  */
 #include "detail/DepthOfScan.h"
+#include "detail/MapDefinitionSections.h"
 
-#include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/CHOCPointsMap.h>
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -24,16 +24,12 @@ CHOCPointsMap::TMapDefinition::TMapDefinition() = default;
 void CHOCPointsMap::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& prefix)
 {
-	hocOpts.loadFromConfigFile(source, prefix + "_creationOpts");
-	insertionOpts.loadFromConfigFile(source, prefix + "_insertOpts");
-	likelihoodOpts.loadFromConfigFile(source, prefix + "_likelihoodOpts");
+	detail::loadMapSections(source, prefix, hocOpts, insertionOpts, likelihoodOpts);
 }
 
 void CHOCPointsMap::TMapDefinition::dumpToTextStream_map_specific(std::ostream& out) const
 {
-	hocOpts.dumpToTextStream(out);
-	insertionOpts.dumpToTextStream(out);
-	likelihoodOpts.dumpToTextStream(out);
+	detail::dumpMapSections(out, hocOpts, insertionOpts, likelihoodOpts);
 }
 
 mrpt::maps::CMetricMap* CHOCPointsMap::internal_CreateFromMapDefinition(const mrpt::maps::TMetricMapInitializer& _def)
@@ -139,14 +135,11 @@ VoxelIndex indexPoints(const std::vector<CHOCPointsMap::Point>& pts, double s)
 }
 }  // namespace
 
-bool CHOCPointsMap::internal_insertObservation(const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
+bool CHOCPointsMap::insertDepthScan(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam)
 {
-	const auto* scan = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	if (!scan) return false;
 	cv::Mat depth;
 	core::RgbdCamera cam;
-	if (!detail::depthOfScan(*scan, depth, cam)) return false;
-	const mrpt::poses::CPose3D T_world_cam = core::cameraPoseFromSensorPose((robotPose ? *robotPose : mrpt::poses::CPose3D()) + scan->sensorPose);
+	if (!detail::depthOfScan(scan, depth, cam)) return false;
 	const mrpt::poses::CPose3D T_cam_world = -T_world_cam;
 	const Eigen::Vector3d centre(T_world_cam.x(), T_world_cam.y(), T_world_cam.z());
 	const auto& geom = geometry();
@@ -194,18 +187,11 @@ bool CHOCPointsMap::internal_insertObservation(const mrpt::obs::CObservation& ob
 	return true;
 }
 
-bool CHOCPointsMap::internal_canComputeObservationLikelihood(const mrpt::obs::CObservation& obs) const
+double CHOCPointsMap::depthScanLikelihood(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) const
 {
-	return dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs) != nullptr && !m_points.empty();
-}
-
-double CHOCPointsMap::internal_computeObservationLikelihood(const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const
-{
-	const auto* scan = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
 	cv::Mat depth;
 	core::RgbdCamera cam;
-	if (!scan || !detail::depthOfScan(*scan, depth, cam) || m_points.empty()) return 0;
-	const mrpt::poses::CPose3D T_world_cam = core::cameraPoseFromSensorPose(takenFrom + scan->sensorPose);
+	if (!detail::depthOfScan(scan, depth, cam) || m_points.empty()) return 0;
 	const double s = std::max(insertionOptions.pointSpacing, 3 * likelihoodOptions.sigma);
 	const auto idx = indexPoints(m_points, s);
 	const double inv2s2 = 1.0 / (2 * likelihoodOptions.sigma * likelihoodOptions.sigma);

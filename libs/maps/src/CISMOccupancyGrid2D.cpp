@@ -2,6 +2,8 @@
  * Construction, MAP_DEFINITION (INI creation), cell access and grid growth.
  * Insertion: CISMOccupancyGrid2D_insert.cpp; serialization and exports: _io.cpp.
  */
+#include "detail/MapDefinitionSections.h"
+
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <mrpt/maps/CMultiMetricMap.h>
 
@@ -20,16 +22,12 @@ void CISMOccupancyGrid2D::TMapDefinition::loadFromConfigFile_map_specific(
 	const mrpt::config::CConfigFileBase& source, const std::string& sectionNamePrefix)
 {
 	optionSection = sectionNamePrefix;
-	creationOpts.loadFromConfigFile(source, sectionNamePrefix + "_creationOpts");
-	insertionOpts.loadFromConfigFile(source, sectionNamePrefix + "_insertOpts");
-	likelihoodOpts.loadFromConfigFile(source, sectionNamePrefix + "_likelihoodOpts");
+	detail::loadMapSections(source, sectionNamePrefix, creationOpts, insertionOpts, likelihoodOpts);
 }
 
 void CISMOccupancyGrid2D::TMapDefinition::dumpToTextStream_map_specific(std::ostream& out) const
 {
-	creationOpts.dumpToTextStream(out);
-	insertionOpts.dumpToTextStream(out);
-	likelihoodOpts.dumpToTextStream(out);
+	detail::dumpMapSections(out, creationOpts, insertionOpts, likelihoodOpts);
 }
 
 mrpt::maps::CMetricMap* CISMOccupancyGrid2D::internal_CreateFromMapDefinition(

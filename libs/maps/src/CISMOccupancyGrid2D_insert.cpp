@@ -2,7 +2,6 @@
  * Inserting keyframes (sparse points or dense depth) with the practical ISM, floor estimation,
  * rebuild after loop closure, and the observation likelihood.
  */
-#include <keygrid/core/FrameConventions.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/FloorToInt.h>
@@ -529,15 +528,10 @@ bool CISMOccupancyGrid2D::insertKeyframeDepth(
 	return true;
 }
 
-bool CISMOccupancyGrid2D::internal_insertObservation(
-	const mrpt::obs::CObservation& obs, const std::optional<const CPose3D>& robotPose)
+bool CISMOccupancyGrid2D::insertDepthScan(const mrpt::obs::CObservation3DRangeScan& scan, const CPose3D& T_world_cam)
 {
-	const auto* o = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	if (!o) return false;
-	o->load();  // external range images
-	const CPose3D T_world_robot = robotPose ? *robotPose : CPose3D();
-	const CPose3D T_world_cam = core::cameraPoseFromSensorPose(T_world_robot + o->sensorPose);
-	return insertKeyframeDepth(m_nextAutoKeyframeId++, T_world_cam, *o);
+	scan.load();  // external range images
+	return insertKeyframeDepth(m_nextAutoKeyframeId++, T_world_cam, scan);
 }
 
 CISMOccupancyGrid2D::BandWindow CISMOccupancyGrid2D::bandWindow(double x0, double x1, double y0, double y1) const
@@ -568,26 +562,17 @@ double CISMOccupancyGrid2D::applyTrajectoryCorrection(const std::map<uint64_t, C
 	return m_lastRebuildSeconds;
 }
 
-bool CISMOccupancyGrid2D::internal_canComputeObservationLikelihood(const mrpt::obs::CObservation& obs) const
-{
-	const auto* o = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	return o != nullptr && o->hasRangeImage;
-}
-
 /* Likelihood of a depth image: the obstacle-band points, each independently, hit an occupied
  * cell with probability p(cell), mixed with an outlier floor:
  *     log L = sum_i log(eps + (1 - eps) p(cell_i)),   eps = outlierProbability. */
-double CISMOccupancyGrid2D::internal_computeObservationLikelihood(
-	const mrpt::obs::CObservation& obs, const CPose3D& takenFrom) const
+double CISMOccupancyGrid2D::depthScanLikelihood(const mrpt::obs::CObservation3DRangeScan& scan, const CPose3D& T_world_cam) const
 {
-	const auto* o = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	if (!o || !o->hasRangeImage) return 0.0;
-	o->load();
-	const CPose3D T_world_cam = core::cameraPoseFromSensorPose(takenFrom + o->sensorPose);
+	if (!scan.hasRangeImage) return 0.0;
+	scan.load();
 	const RigidF T(T_world_cam - floorPose());
 	const double eps = likelihoodOptions.outlierProbability;
 	double logLik = 0;
-	for (const auto& p : depthToCameraPoints(*o, likelihoodOptions.decimation))
+	for (const auto& p : depthToCameraPoints(scan, likelihoodOptions.decimation))
 	{
 		float fx, fy, fz;
 		T.apply(p.x, p.y, p.z, fx, fy, fz);

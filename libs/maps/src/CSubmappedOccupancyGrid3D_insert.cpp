@@ -3,7 +3,6 @@
  */
 #include "detail/DepthOfScan.h"
 
-#include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 
@@ -105,18 +104,13 @@ CSubmappedOccupancyGrid3D::InsertResult CSubmappedOccupancyGrid3D::integrateFram
 	return r;
 }
 
-bool CSubmappedOccupancyGrid3D::internal_insertObservation(
-	const mrpt::obs::CObservation& obs, const std::optional<const mrpt::poses::CPose3D>& robotPose)
+bool CSubmappedOccupancyGrid3D::insertDepthScan(
+	const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam)
 {
-	const auto* scan = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	if (!scan) return false;
 	cv::Mat depth;
 	core::RgbdCamera cam;
-	if (!detail::depthOfScan(*scan, depth, cam)) return false;
+	if (!detail::depthOfScan(scan, depth, cam)) return false;
 
-	const mrpt::poses::CPose3D T_world_robot = robotPose ? *robotPose : mrpt::poses::CPose3D();
-	const mrpt::poses::CPose3D T_world_cam =
-		core::cameraPoseFromSensorPose(T_world_robot + scan->sensorPose);
 	if (m_lastObsCamPose) m_obsTravelled += T_world_cam.distanceTo(*m_lastObsCamPose);
 	m_lastObsCamPose = T_world_cam;
 
@@ -130,24 +124,14 @@ bool CSubmappedOccupancyGrid3D::internal_insertObservation(
 	return true;
 }
 
-bool CSubmappedOccupancyGrid3D::internal_canComputeObservationLikelihood(
-	const mrpt::obs::CObservation& obs) const
-{
-	return dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs) != nullptr;
-}
-
-double CSubmappedOccupancyGrid3D::internal_computeObservationLikelihood(
-	const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const
+double CSubmappedOccupancyGrid3D::depthScanLikelihood(
+	const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) const
 {
 	// log p(z | m) = sum over decimated pixels of log P(voxel at the measured point occupied),
 	// unknown voxels count 0.5, every probability floored at minProbability.
-	const auto* scan = dynamic_cast<const mrpt::obs::CObservation3DRangeScan*>(&obs);
-	if (!scan) return 0.0;
 	cv::Mat depth;
 	core::RgbdCamera cam;
-	if (!detail::depthOfScan(*scan, depth, cam)) return 0.0;
-	const mrpt::poses::CPose3D T_world_cam =
-		core::cameraPoseFromSensorPose(takenFrom + scan->sensorPose);
+	if (!detail::depthOfScan(scan, depth, cam)) return 0.0;
 	const unsigned dec = likelihoodOptions.decimation;
 	const double pMin = likelihoodOptions.minProbability;
 	const core::PinholeIntrinsics K = cam.pinhole();

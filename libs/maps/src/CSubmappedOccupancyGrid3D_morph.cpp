@@ -9,6 +9,18 @@
 
 using namespace keygrid;
 
+MorphKeyframe CSubmappedOccupancyGrid3D::morphKeyframe(uint64_t id, const KeyframeRecord& rec, const mrpt::poses::CPose3D& T_world_cam_new)
+{
+	MorphKeyframe k;
+	k.id = id;
+	k.submap = rec.submap;
+	k.travelled = rec.travelled;
+	k.camera = rec.camera;
+	k.T_world_cam_old = rec.T_world_cam;
+	k.T_world_cam_new = T_world_cam_new;
+	return k;
+}
+
 MorphingStats CSubmappedOccupancyGrid3D::morphAndMergeSubmaps(const TrajectoryCorrection& corr)
 {
 	std::vector<const VoxelBlockGrid*> sources;
@@ -18,15 +30,8 @@ MorphingStats CSubmappedOccupancyGrid3D::morphAndMergeSubmaps(const TrajectoryCo
 	kfs.reserve(m_keyframes.size());
 	for (const auto& [id, rec] : m_keyframes)
 	{
-		MorphKeyframe k;
-		k.id = id;
-		k.submap = rec.submap;
-		k.travelled = rec.travelled;
-		k.camera = rec.camera;
-		k.T_world_cam_old = rec.T_world_cam;
 		const auto it = corr.find(id);
-		k.T_world_cam_new = it != corr.end() ? it->second.T_world_cam_new : rec.T_world_cam;
-		kfs.push_back(k);
+		kfs.push_back(morphKeyframe(id, rec, it != corr.end() ? it->second.T_world_cam_new : rec.T_world_cam));
 	}
 
 	MorphingStats stats;

@@ -23,14 +23,6 @@ core::OptionFields ConflictOptions::fields()
 	return f;
 }
 
-void ConflictOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void ConflictOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void ConflictOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 FrameEvidence evaluateFrame(

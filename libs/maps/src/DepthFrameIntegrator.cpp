@@ -40,17 +40,6 @@ core::OptionFields DepthIntegrationOptions::fields()
 	return f;
 }
 
-void DepthIntegrationOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void DepthIntegrationOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
-}
-
 void DepthIntegrationOptions::validate(const std::string& s) const
 {
 	core::validateFields(*this, s);

@@ -59,14 +59,6 @@ core::OptionFields FloorFrameOptions::fields()
 	return f;
 }
 
-void FloorFrameOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void FloorFrameOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void FloorFrameOptions::validate(const std::string& s) const
 {
 	core::validateFields(*this, s);

@@ -23,17 +23,6 @@ core::OptionFields FloorPlaneRansacOptions::fields()
 	return f;
 }
 
-void FloorPlaneRansacOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void FloorPlaneRansacOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
-}
-
 void FloorPlaneRansacOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 namespace

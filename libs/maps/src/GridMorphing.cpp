@@ -33,14 +33,6 @@ core::OptionFields MorphingOptions::fields()
 	return f;
 }
 
-void MorphingOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void MorphingOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void MorphingOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 using namespace detail::morphing;

@@ -30,17 +30,6 @@ core::OptionFields CameraHeightScaleOptions::fields()
 	return f;
 }
 
-void CameraHeightScaleOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void CameraHeightScaleOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
-}
-
 void CameraHeightScaleOptions::validate(const std::string& section) const { core::validateFields(*this, section); }
 
 const char* toString(CameraHeightScaleFailure f)

@@ -30,14 +30,6 @@ core::OptionFields FeatureOptions::fields()
 	return f;
 }
 
-void FeatureOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void FeatureOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void FeatureOptions::validate(const std::string& s) const
 {
 	core::validateFields(*this, s);

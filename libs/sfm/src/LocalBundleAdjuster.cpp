@@ -77,14 +77,6 @@ core::OptionFields BundleAdjusterOptions::fields()
 	return f;
 }
 
-void BundleAdjusterOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void BundleAdjusterOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void BundleAdjusterOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 BundleAdjustment BundleAdjustment::around(

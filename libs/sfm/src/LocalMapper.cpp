@@ -26,14 +26,6 @@ core::OptionFields LocalMapperOptions::fields()
 	return f;
 }
 
-void LocalMapperOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void LocalMapperOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void LocalMapperOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 LocalMapper::LocalMapper(SparseMap& map, const LocalMapperOptions& opts, const MatcherOptions& matcher)

@@ -23,14 +23,6 @@ core::OptionFields MonocularOptions::fields()
 	return f;
 }
 
-void MonocularOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void MonocularOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void MonocularOptions::validate(const std::string& s) const
 {
 	core::validateFields(*this, s);

@@ -43,17 +43,6 @@ core::OptionFields TrackerOptions::fields()
 	return f;
 }
 
-void TrackerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void TrackerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const
-{
-	core::writeFields(*this, c, s);
-}
-
 void TrackerOptions::validate(const std::string& s) const
 {
 	core::validateFields(*this, s);

@@ -37,14 +37,6 @@ core::OptionFields TwoViewOptions::fields()
 	return f;
 }
 
-void TwoViewOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void TwoViewOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void TwoViewOptions::validate(const std::string& section) const { core::validateFields(*this, section); }
 
 bool TwoViewOptions::isValid(std::string* error) const

@@ -26,14 +26,6 @@ core::OptionFields MapFeedOptions::fields()
 	return f;
 }
 
-void MapFeedOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void MapFeedOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void MapFeedOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 namespace

@@ -18,14 +18,6 @@ core::OptionFields MetricScaleOptions::fields()
 	return f;
 }
 
-void MetricScaleOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void MetricScaleOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void MetricScaleOptions::validate(const std::string& s) const
 {
 	core::validateFields(*this, s);

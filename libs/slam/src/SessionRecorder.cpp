@@ -96,14 +96,6 @@ core::OptionFields SessionRecorderOptions::fields()
 	return f;
 }
 
-void SessionRecorderOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void SessionRecorderOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void SessionRecorderOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 SessionRecorder::SessionRecorder(const std::string& path, const SessionRecorderOptions& opts) : m_path(path), m_opts(opts)

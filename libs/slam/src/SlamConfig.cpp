@@ -34,14 +34,6 @@ core::OptionFields RefinementOptions::fields()
 	return f;
 }
 
-void RefinementOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s)
-{
-	fields().read(c, s);
-	validate(s);
-}
-
-void RefinementOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const { core::writeFields(*this, c, s); }
-
 void RefinementOptions::validate(const std::string& s) const { core::validateFields(*this, s); }
 
 core::OptionFields SlamConfig::fields()

@@ -21,17 +21,6 @@ core::OptionFields ImageCodecOptions::fields()
 
 void ImageCodecOptions::validate(const std::string& section) const { core::validateFields(*this, section); }
 
-void ImageCodecOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section)
-{
-	fields().read(cfg, section);
-	validate(section);
-}
-
-void ImageCodecOptions::saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const
-{
-	core::writeFields(*this, cfg, section);
-}
-
 KeyFrameImageCodec::KeyFrameImageCodec(const ImageCodecOptions& opts) : m_opts(opts)
 {
 	m_opts.validate();

@@ -18,15 +18,4 @@ core::OptionFields SessionStoreOptions::fields()
 
 void SessionStoreOptions::validate(const std::string& section) const { core::validateFields(*this, section); }
 
-void SessionStoreOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section)
-{
-	fields().read(cfg, section);
-	validate(section);
-}
-
-void SessionStoreOptions::saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const
-{
-	core::writeFields(*this, cfg, section);
-}
-
 }  // namespace keygrid::store

@@ -29,23 +29,7 @@ void forKeyFrameFields(KeyFrame& kf, Record& rec, Copy&& copy)
 	copy(kf.hasParent, rec.hasParent);
 }
 
-/** The same for a landmark and its record. */
-template <class Landmark, class Record, class Copy>
-void forLandmarkFields(Landmark& lm, Record& rec, Copy&& copy)
-{
-	copy(lm.id, rec.id);
-	copy(lm.p_world, rec.p_world);
-	copy(lm.descriptor, rec.descriptor);
-	copy(lm.observations, rec.observations);
-	copy(lm.normal, rec.normal);
-	copy(lm.minDistance, rec.minDistance);
-	copy(lm.maxDistance, rec.maxDistance);
-	copy(lm.firstKeyFrame, rec.firstKeyFrame);
-	copy(lm.visibleCount, rec.visibleCount);
-	copy(lm.foundCount, rec.foundCount);
-}
-
-/** copy() of the for*Fields tables from the frontend's object into the record ... */
+/** copy() of the forKeyFrameFields table from the frontend's object into the record ... */
 const auto intoRecord = [](const auto& object, auto& record) { record = object; };
 /** ... and from the record into the object. */
 const auto fromRecord = [](auto& object, const auto& record) { object = record; };
@@ -75,7 +59,7 @@ EncodedImages encodeImages(const sfm::KeyFrame& kf, const KeyFrameImageCodec& co
 LandmarkRecord toRecord(const sfm::Landmark& lm)
 {
 	LandmarkRecord r;
-	forLandmarkFields(lm, r, intoRecord);
+	static_cast<sfm::LandmarkState&>(r) = lm;
 	r.hocCounts = lm.hoc.counts();
 	return r;
 }
@@ -83,7 +67,7 @@ LandmarkRecord toRecord(const sfm::Landmark& lm)
 sfm::Landmark toLandmark(const LandmarkRecord& rec)
 {
 	sfm::Landmark lm;
-	forLandmarkFields(lm, rec, fromRecord);
+	static_cast<sfm::LandmarkState&>(lm) = rec;
 	lm.hoc.setCounts(rec.hocCounts);
 	return lm;
 }

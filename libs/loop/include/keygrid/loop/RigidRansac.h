@@ -5,6 +5,7 @@
  * frame) -> T_a_b with p_a ~= T_a_b p_b, by RANSAC over minimal sets of 3 pairs, closed-form
  * Horn/Umeyama fits (Eigen::umeyama), then refinement on the inliers until the set is stable.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 
 #include <Eigen/Core>
@@ -14,14 +15,9 @@
 #include <string>
 #include <vector>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::loop
 {
-struct RigidRansacOptions
+struct RigidRansacOptions : public core::FieldTableOptions<RigidRansacOptions>
 {
 	/** Inlier if |p_a - T_a_b p_b| is below this [m] (Default: 0.05 m) */
 	double inlierThreshold{0.05};
@@ -44,8 +40,6 @@ struct RigidRansacOptions
 	void validate(const std::string& section = "ransac") const;
 	/** validate() as a flag, its message in `why`. */
 	bool isValid(std::string* why = nullptr) const;
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 };
 
 struct RigidRansacResult

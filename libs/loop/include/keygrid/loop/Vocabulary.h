@@ -8,6 +8,7 @@
  * bit-majority centres) or CV_32F (e.g. SIFT 128 floats: Euclidean distance, mean centres).
  * The tree is built deterministically for a given seed, whatever the number of threads.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/loop/BowVector.h>
 #include <opencv2/core.hpp>
@@ -18,11 +19,6 @@
 #include <string>
 #include <vector>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::loop
 {
 enum class DescriptorType : std::uint32_t
@@ -31,7 +27,7 @@ enum class DescriptorType : std::uint32_t
 	Float = 1    //!< CV_32F rows, L2 distance
 };
 
-struct VocabularyOptions
+struct VocabularyOptions : public core::FieldTableOptions<VocabularyOptions>
 {
 	/** Branching factor k: children per node (Default: 10) */
 	int branching{10};
@@ -50,9 +46,6 @@ struct VocabularyOptions
 	/** Throws std::invalid_argument("[section] key = value (must be ...)") on a bad value, and
 	 * for a tree of more than 4e9 words (word ids are 32-bit). */
 	void validate(const std::string& section = "vocabulary") const;
-	/** Reads the keys strictly and validates them; throws naming [section] and key. */
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 };
 
 class Vocabulary

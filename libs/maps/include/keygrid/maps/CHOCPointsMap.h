@@ -20,8 +20,9 @@
  * In a SLAM run (maps::KeyFrameMap, CHOCPointsMap_keyframes.cpp) the map follows the
  * frontend's landmarks (syncLandmarks) and takes nothing from keyframes or corrections itself.
  */
+#include <keygrid/core/FieldTableOptions.h>
+#include <keygrid/maps/DepthScanMap.h>
 #include <keygrid/maps/ExportFrame.h>
-#include <keygrid/maps/FieldTableOptions.h>
 #include <keygrid/maps/HocGeometry.h>
 #include <keygrid/maps/HocHistogram.h>
 #include <keygrid/maps/KeyFrameMap.h>
@@ -37,7 +38,7 @@
 
 namespace keygrid
 {
-class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
+class CHOCPointsMap : public maps::DepthScanMap, public maps::KeyFrameMap
 {
 	DEFINE_SERIALIZABLE(CHOCPointsMap, keygrid)
 
@@ -52,7 +53,7 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 	};
 
 	/** insertObservation() of depth scans. INI section `_insertOpts`. */
-	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
+	struct TInsertionOptions : public core::FieldTableOptions<TInsertionOptions>
 	{
 		/** Use every n-th pixel in rows and columns (Default: 8) */
 		int decimation{8};
@@ -68,7 +69,7 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 	/** Likelihood of a depth scan: product over decimated pixels of a Gaussian of the distance
 	 * to the nearest map point (searched in the 27 neighbouring spacing-voxels), floored.
 	 * INI section `_likelihoodOpts`. */
-	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
+	struct TLikelihoodOptions : public core::FieldTableOptions<TLikelihoodOptions>
 	{
 		int decimation{16};  //!< (Default: 16)
 		double sigma{0.05};  //!< [m] (Default: 0.05)
@@ -99,6 +100,10 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 	explicit CHOCPointsMap(const maps::HocOptions& opts) : hocOptions(opts) {}
 
 	std::size_t size() const { return m_points.size(); }
+	/** CMetricMap: no points. */
+	bool isEmpty() const override { return m_points.empty(); }
+	/** Points and bin geometry in one line. */
+	std::string asString() const override;
 	const std::vector<Point>& points() const { return m_points; }
 	/** Replaces all points. Throws std::invalid_argument if a histogram has the wrong size. */
 	void setPoints(std::vector<Point> pts);
@@ -115,6 +120,10 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 	 * `observations` (sum of positive counts). Throws std::runtime_error if not writable.
 	 * Points are mapped into `frame` (e.g. the floor frame); frame.comment is a PLY comment. */
 	void saveAsPly(const std::string& path, const maps::ExportFrame& frame = {}) const;
+	/** CMetricMap: writes `<prefix>.ply` (saveAsPly). */
+	void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
+	/** Visualizable: the points coloured by weight and the glyphs of TRenderOptions. */
+	void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
 
 	/** @name In a SLAM run (maps::KeyFrameMap)
 	 * @{ */
@@ -138,21 +147,13 @@ class CHOCPointsMap : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
 	std::string summaryJsonFields() const override;
 	/** @} */
 
-	// CMetricMap / Stringifyable / Visualizable
-	bool isEmpty() const override { return m_points.empty(); }
-	/** Writes `<prefix>.ply`. */
-	void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
-	void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
-	std::string asString() const override;
-
    protected:
 	void internal_clear() override;
-	bool internal_insertObservation(
-		const mrpt::obs::CObservation& obs,
-		const std::optional<const mrpt::poses::CPose3D>& robotPose = std::nullopt) override;
-	double internal_computeObservationLikelihood(
-		const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const override;
-	bool internal_canComputeObservationLikelihood(const mrpt::obs::CObservation& obs) const override;
+	// maps::DepthScanMap
+	bool insertDepthScan(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) override;
+	/** Any depth scan, once the map has points. */
+	bool canComputeDepthScanLikelihood(const mrpt::obs::CObservation3DRangeScan&) const override { return !m_points.empty(); }
+	double depthScanLikelihood(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) const override;
 
    private:
 	std::vector<Point> m_points;

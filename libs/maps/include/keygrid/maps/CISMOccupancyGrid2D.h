@@ -3,8 +3,9 @@
  * A 2D navigation occupancy grid filled from visual-SLAM keyframes with the erf inverse sensor
  * model of Lu & Wang (2018). MRPT CMetricMap plugin registered as "ismOccupancyGrid2D".
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
-#include <keygrid/maps/FieldTableOptions.h>
+#include <keygrid/maps/DepthScanMap.h>
 #include <keygrid/maps/FloorPlaneEstimator.h>
 #include <keygrid/maps/InverseSensorModel.h>
 #include <keygrid/maps/KeyFrameMap.h>
@@ -60,13 +61,13 @@ enum class CellState : uint8_t
  * In a SLAM run (maps::KeyFrameMap, CISMOccupancyGrid2D_keyframes.cpp) the grid takes the
  * run's floor frame, its keyframes' map points or depth, and rebuilds on corrections.
  */
-class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
+class CISMOccupancyGrid2D : public maps::DepthScanMap, public maps::KeyFrameMap
 {
 	DEFINE_SERIALIZABLE(CISMOccupancyGrid2D, keygrid)
 
    public:
 	/** Creation options: the grid geometry. */
-	struct TCreationOptions : public maps::FieldTableOptions<TCreationOptions>
+	struct TCreationOptions : public core::FieldTableOptions<TCreationOptions>
 	{
 		/** Cell size [m] (Default: 0.05 m) */
 		double resolution{0.05};
@@ -103,7 +104,7 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	};
 
 	/** Insertion options: ISM, noise, height band, floor frame, traversal, thresholds. */
-	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
+	struct TInsertionOptions : public core::FieldTableOptions<TInsertionOptions>
 	{
 		/** Ideal-model occupancy before the band (Default: 0.30) */
 		double pFree{0.30};
@@ -168,7 +169,7 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	};
 
 	/** Likelihood options for computeObservationLikelihood(CObservation3DRangeScan). */
-	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
+	struct TLikelihoodOptions : public core::FieldTableOptions<TLikelihoodOptions>
 	{
 		/** Use every n-th depth pixel in rows and columns (Default: 8) */
 		int decimation{8};
@@ -300,6 +301,10 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	CellState stateAt(double x, double y) const { return cellState(x2idx(x), y2idx(y)); }
 	/** Number of cells in each state: {unknown, free, occupied}. */
 	std::array<size_t, 3> countStates() const;
+	/** CMetricMap: no cell updated yet (every log-odds 0). */
+	bool isEmpty() const override;
+	/** Size, bounds, cell states and keyframes in one line. */
+	std::string asString() const override;
 	/** The floor frame in use: the external one when set, the estimate when
 	 * estimateFloorFromDepth, else T_world_floor. */
 	const mrpt::poses::CPose3D& floorPose() const
@@ -319,23 +324,20 @@ class CISMOccupancyGrid2D : public mrpt::maps::CMetricMap, public maps::KeyFrame
 	void saveAsImage(const std::string& file) const;
 	/** The same grid as MRPT's COccupancyGridMap2D (its cells store p(free) = 1 - p). */
 	mrpt::maps::COccupancyGridMap2D toOccupancyGridMap2D() const;
-	/** @} */
-
-	// CMetricMap
-	bool isEmpty() const override;
+	/** CMetricMap: writes `<prefix>.yaml` + `.pgm` (saveAsRosMapServer) and `<prefix>.png`
+	 * (saveAsImage). */
 	void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
+	/** toOccupancyGridMap2D()'s textured plane at the floor pose (when enableSaveAs3DObject). */
 	void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
-	std::string asString() const override;
+	/** @} */
 
    protected:
 	void internal_clear() override;
-	bool internal_insertObservation(
-		const mrpt::obs::CObservation& obs,
-		const std::optional<const mrpt::poses::CPose3D>& robotPose = std::nullopt) override;
-	double internal_computeObservationLikelihood(
-		const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const override;
-	bool internal_canComputeObservationLikelihood(
-		const mrpt::obs::CObservation& obs) const override;
+	// maps::DepthScanMap
+	bool insertDepthScan(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) override;
+	/** Depth scans that hold a range image. */
+	bool canComputeDepthScanLikelihood(const mrpt::obs::CObservation3DRangeScan& scan) const override { return scan.hasRangeImage; }
+	double depthScanLikelihood(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) const override;
 
    private:
 	double m_resolution{0.05};

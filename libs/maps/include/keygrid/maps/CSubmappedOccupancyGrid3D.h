@@ -29,11 +29,12 @@
  * worker threads (options `threads`, `morphThreads`) and give the same result for any count.
  * Documentation and measurements: doc/maps-3d.md.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/ConflictDetector.h>
 #include <keygrid/maps/DepthFrameIntegrator.h>
+#include <keygrid/maps/DepthScanMap.h>
 #include <keygrid/maps/ExportFrame.h>
-#include <keygrid/maps/FieldTableOptions.h>
 #include <keygrid/maps/GridMorphing.h>
 #include <keygrid/maps/KeyFrameMap.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
@@ -50,7 +51,7 @@
 
 namespace keygrid
 {
-class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::KeyFrameMap
+class CSubmappedOccupancyGrid3D : public maps::DepthScanMap, public maps::KeyFrameMap
 {
 	DEFINE_SERIALIZABLE(CSubmappedOccupancyGrid3D, keygrid)
 
@@ -96,7 +97,7 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	};
 
 	/** Options of observation insertion (INI section `..._insertOpts`). */
-	struct TInsertionOptions : public maps::FieldTableOptions<TInsertionOptions>
+	struct TInsertionOptions : public core::FieldTableOptions<TInsertionOptions>
 	{
 		DepthIntegrationOptions integration;
 		ConflictOptions conflict;
@@ -113,7 +114,7 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	};
 
 	/** Options of computeObservationLikelihood (INI section `..._likelihoodOpts`). */
-	struct TLikelihoodOptions : public maps::FieldTableOptions<TLikelihoodOptions>
+	struct TLikelihoodOptions : public core::FieldTableOptions<TLikelihoodOptions>
 	{
 		/** Use every N-th pixel in u and v (Default: 10) */
 		unsigned decimation{10};
@@ -187,6 +188,10 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	VoxelBlockGrid fusedGrid() const;
 	/** Centres of the voxels of fusedGrid() with log-odds > 0. */
 	std::vector<mrpt::math::TPoint3D> occupiedVoxelCentres() const;
+	/** CMetricMap: no submap holds a voxel block. */
+	bool isEmpty() const override;
+	/** Resolution, submaps, keyframes, blocks and mode in one line. */
+	std::string asString() const override;
 	/** @} */
 
 	/** @name Trajectory correction
@@ -197,6 +202,9 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	 * recorded when it was integrated (what the grid was built with), not corr's
 	 * T_world_cam_old. Keyframe poses are updated to the new ones. */
 	MorphingStats morphAndMergeSubmaps(const TrajectoryCorrection& corr);
+	/** Keyframe `id`, recorded as `rec`, as morphAndMerge() takes it: from the pose it was
+	 * integrated at to T_world_cam_new. */
+	static MorphKeyframe morphKeyframe(uint64_t id, const KeyframeRecord& rec, const mrpt::poses::CPose3D& T_world_cam_new);
 
 	struct ReintegrationStats
 	{
@@ -257,25 +265,19 @@ class CSubmappedOccupancyGrid3D : public mrpt::maps::CMetricMap, public maps::Ke
 	/** Heap bytes of all submap grids (VoxelBlockGrid::memoryBytes) plus stored depth and map
 	 * points. */
 	std::size_t memoryBytes() const;
-	/** @} */
-
-	// CMetricMap / Stringifyable / Visualizable
-	bool isEmpty() const override;
-	/** Writes `<prefix>.bt`, `<prefix>_occupied.ply` and `<prefix>.3Dscene`. */
+	/** CMetricMap: writes `<prefix>.bt`, `<prefix>_occupied.ply` and `<prefix>.3Dscene`. */
 	void saveMetricMapRepresentationToFile(const std::string& filNamePrefix) const override;
 	/** Occupied voxel centres as one mrpt::opengl::CPointCloud, coloured by height. */
 	void getVisualizationInto(mrpt::opengl::CSetOfObjects& outObj) const override;
-	std::string asString() const override;
+	/** @} */
 
    protected:
 	void internal_clear() override;
-	bool internal_insertObservation(
-		const mrpt::obs::CObservation& obs,
-		const std::optional<const mrpt::poses::CPose3D>& robotPose = std::nullopt) override;
-	double internal_computeObservationLikelihood(
-		const mrpt::obs::CObservation& obs, const mrpt::poses::CPose3D& takenFrom) const override;
-	bool internal_canComputeObservationLikelihood(
-		const mrpt::obs::CObservation& obs) const override;
+	// maps::DepthScanMap
+	bool insertDepthScan(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) override;
+	/** Any depth scan (an empty grid scores unknown voxels). */
+	bool canComputeDepthScanLikelihood(const mrpt::obs::CObservation3DRangeScan&) const override { return true; }
+	double depthScanLikelihood(const mrpt::obs::CObservation3DRangeScan& scan, const mrpt::poses::CPose3D& T_world_cam) const override;
 
    private:
 	DepthFrameIntegrator& integrator();

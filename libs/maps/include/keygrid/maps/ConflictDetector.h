@@ -24,6 +24,7 @@
  *   conflict                     : only in Exploration, when the stale contradictions reach both
  *                                  conflictMinVoxels and conflictMinFraction of the frame's hit voxels.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/maps/DepthFrameIntegrator.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
@@ -31,15 +32,10 @@
 #include <cstddef>
 #include <string>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid
 {
 /** Parameters of the mode machine and of conflict detection. */
-struct ConflictOptions
+struct ConflictOptions : public core::FieldTableOptions<ConflictOptions>
 {
 	/** |camera travelled - voxel travelled| above which a known voxel is "stale" [m]
 	 * (Default: 1.5 m) */
@@ -64,8 +60,6 @@ struct ConflictOptions
 
 	/** The INI keys, with description and rule. */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming [section], key and value of the first bad field. */
 	void validate(const std::string& section = "insertOpts") const;
 };

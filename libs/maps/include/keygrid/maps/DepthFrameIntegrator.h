@@ -16,6 +16,7 @@
  * discretizeEndpoints (the default, = OctoMap's discretize=true) one ray is cast per distinct
  * end voxel, to its centre; otherwise one per pixel.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
@@ -28,15 +29,10 @@
 #include <string>
 #include <vector>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid
 {
 /** Parameters of depth-frame integration. */
-struct DepthIntegrationOptions
+struct DepthIntegrationOptions : public core::FieldTableOptions<DepthIntegrationOptions>
 {
 	/** Rays are cut at this Euclidean range from the camera centre [m] (Default: 4 m) */
 	double maxRange{4.0};
@@ -69,8 +65,6 @@ struct DepthIntegrationOptions
 
 	/** The INI keys, with description and rule. */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming [section], key and value of the first bad field. */
 	void validate(const std::string& section = "insertOpts") const;
 };

@@ -11,6 +11,7 @@
  * cameras (the mean of their -y axes) or from the INI (up_hint), and the whole frame can be
  * given instead of estimated (T_world_floor).
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/maps/FloorPlaneEstimator.h>
 #include <mrpt/config/CConfigFileBase.h>
@@ -27,7 +28,7 @@
 namespace keygrid::maps
 {
 /** Options of the floor frame of a run (INI section [floor] of keygrid-slam). */
-struct FloorFrameOptions
+struct FloorFrameOptions : public core::FieldTableOptions<FloorFrameOptions>
 {
 	/** The floor frame given instead of estimated, "[x y z yaw pitch roll]" (m, deg) in the
 	 * SLAM world; empty (INI: "estimate") = estimate it (Default: empty) */
@@ -96,8 +97,6 @@ struct FloorFrameOptions
 	/** The [floor] keys (`T_world_floor` = estimate | [x y z yaw pitch roll], `up_hint`,
 	 * `initial_keyframes`, ...). */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "floor") const;
 	/** givenPose parsed; nullopt when empty. */

@@ -4,6 +4,7 @@
  * not gravity aligned (TUM). The floor is taken as the LOWEST large plane roughly perpendicular
  * to an "up" hint (a desk top is often larger in view than the floor) that lies below the camera.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/TPoint3D.h>
@@ -16,7 +17,7 @@
 
 namespace keygrid::maps
 {
-struct FloorPlaneRansacOptions
+struct FloorPlaneRansacOptions : public core::FieldTableOptions<FloorPlaneRansacOptions>
 {
 	/** Point-to-plane distance of an inlier [m] (Default: 0.02 m) */
 	double inlierDistance{0.02};
@@ -36,8 +37,6 @@ struct FloorPlaneRansacOptions
 
 	/** INI keys prefixed with "floorRansac_" (they live in another struct's section). */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& source, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const;
 	/** Throws std::invalid_argument naming [section], key and value of the first bad field. */
 	void validate(const std::string& section = "insertOpts") const;
 };

@@ -48,6 +48,7 @@
  * cube crosses one block face): no bit, no lookup. Optionally (maxKeyframesPerBlock) only the K
  * keyframes with the most readable voxels times weight are kept per block: an approximation.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/VoxelBlockGrid.h>
@@ -57,11 +58,6 @@
 #include <map>
 #include <string>
 #include <vector>
-
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
 
 namespace keygrid
 {
@@ -79,7 +75,7 @@ struct PoseCorrection
 /** keyframe id -> {old pose, new pose}. */
 using TrajectoryCorrection = std::map<uint64_t, PoseCorrection>;
 
-struct MorphingOptions
+struct MorphingOptions : public core::FieldTableOptions<MorphingOptions>
 {
 	/** Depth of the keyframe view cones [m] (Default: 4 m, the integration max range) */
 	double viewConeMaxRange{4.0};
@@ -119,8 +115,6 @@ struct MorphingOptions
 	/** The INI keys (prefixed "morph", they share the insertion section), with description and
 	 * rule. */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming [section], key and value of the first bad field. */
 	void validate(const std::string& section = "insertOpts") const;
 };

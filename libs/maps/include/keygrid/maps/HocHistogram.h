@@ -13,8 +13,8 @@
  * Use: a point takes part in data association and pose estimation from a camera in bin b only
  * while p(n_b) > select_threshold; it is removed from the map when max_b p(n_b) < prune_threshold.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
-#include <keygrid/maps/FieldTableOptions.h>
 
 #include <cstdint>
 #include <string>
@@ -22,7 +22,7 @@
 
 namespace keygrid::maps
 {
-struct HocOptions : public maps::FieldTableOptions<HocOptions>
+struct HocOptions : public core::FieldTableOptions<HocOptions>
 {
 	/** Use the HOC in the frontend; false gives the standard (static-world) system, for
 	 * comparisons (Default: false) */

@@ -40,6 +40,7 @@
  * adjustment, not fresh two-view triangulations), or the search may settle on a plane tilted
  * through the floor and the feet of the walls.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/poses/CPose3D.h>
@@ -54,7 +55,7 @@
 namespace keygrid::sfm
 {
 /** Lengths marked [m] are metres of the map rescaled by the current scale estimate. */
-struct CameraHeightScaleOptions
+struct CameraHeightScaleOptions : public core::FieldTableOptions<CameraHeightScaleOptions>
 {
 	/** Height of the camera's optical centre above the floor [m]; 0 = not known: the map
 	 * stays up to scale and the estimator cannot be built (Default: 0) */
@@ -94,8 +95,6 @@ struct CameraHeightScaleOptions
 
 	/** The INI keys, with description and rule (core/OptionFields.h). */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument("[section] key = value (must be ...)") on a bad value. */
 	void validate(const std::string& section = "camera_height_scale") const;
 };

@@ -3,6 +3,7 @@
  * Keypoints and descriptors of a frame: ORB (default) or SIFT, spread evenly over the image by
  * grid bucketing, undistorted, with a validated depth per keypoint.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/Frame.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/FrameFeatures.h>
@@ -10,14 +11,9 @@
 
 #include <string>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::sfm
 {
-struct FeatureOptions
+struct FeatureOptions : public core::FieldTableOptions<FeatureOptions>
 {
 	/** "orb" or "sift" (Default: orb) */
 	std::string type{"orb"};
@@ -47,8 +43,6 @@ struct FeatureOptions
 
 	/** The [features] keys. */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "features") const;
 };

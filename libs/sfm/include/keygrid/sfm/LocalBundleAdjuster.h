@@ -5,6 +5,7 @@
  * Huber loss, analytic Jacobians, Schur complement: Ceres (dense) for local windows, the
  * dedicated sparse solver of BundleLevenbergMarquardt.h for large problems.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/PoseOptimizer.h>
 #include <keygrid/sfm/SparseMap.h>
@@ -13,11 +14,6 @@
 #include <set>
 #include <string>
 #include <vector>
-
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
 
 namespace keygrid::sfm
 {
@@ -35,7 +31,7 @@ enum class BaLinearSolver
 	IterativeSchur
 };
 
-struct BundleAdjusterOptions
+struct BundleAdjusterOptions : public core::FieldTableOptions<BundleAdjusterOptions>
 {
 	/** Covisible keyframes optimised with the current one (Default: 10) */
 	int windowSize{10};
@@ -73,8 +69,6 @@ struct BundleAdjusterOptions
 
 	/** The bundle adjustment's keys (in [mapping]). */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "mapping") const;
 };

@@ -4,6 +4,7 @@
  * fusion of duplicated landmarks with the neighbours, local bundle adjustment, and culling of
  * redundant keyframes.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/sfm/LocalBundleAdjuster.h>
 #include <keygrid/sfm/Matcher.h>
 #include <keygrid/sfm/SparseMap.h>
@@ -16,14 +17,9 @@
 #include <utility>
 #include <vector>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::sfm
 {
-struct LocalMapperOptions
+struct LocalMapperOptions : public core::FieldTableOptions<LocalMapperOptions>
 {
 	/** Neighbour keyframes searched for duplicates of the new keyframe's landmarks (Default: 10) */
 	int fuseNeighbours{10};
@@ -47,8 +43,6 @@ struct LocalMapperOptions
 
 	/** The [mapping] keys, the local bundle adjustment's included. */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "mapping") const;
 };

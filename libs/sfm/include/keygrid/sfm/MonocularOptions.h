@@ -4,20 +4,16 @@
  * matching of the following frames against it, TwoViewInitializer) and the keyframe rule of a
  * camera without depth. INI section [monocular]; the two-view model's keys are part of it.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/LocalBundleAdjuster.h>
 #include <keygrid/sfm/TwoViewInitializer.h>
 
 #include <string>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::sfm
 {
-struct MonocularOptions
+struct MonocularOptions : public core::FieldTableOptions<MonocularOptions>
 {
 	/** A frame becomes the reference of the map start only with more keypoints than this
 	 * (Default: 100, as ORB-SLAM) */
@@ -70,8 +66,6 @@ struct MonocularOptions
 
 	/** The [monocular] keys, the two-view model's included. */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "monocular") const;
 };

@@ -7,6 +7,8 @@
  */
 #include <keygrid/maps/HocHistogram.h>
 #include <keygrid/sfm/FrameFeatures.h>
+#include <keygrid/sfm/Ids.h>
+#include <keygrid/sfm/LandmarkState.h>
 #include <mrpt/poses/CPose3D.h>
 
 #include <Eigen/Core>
@@ -18,25 +20,8 @@
 
 namespace keygrid::sfm
 {
-using KeyFrameId = std::uint64_t;
-using LandmarkId = std::uint64_t;
-constexpr LandmarkId kNoLandmark = ~LandmarkId(0);
-
-struct Landmark
+struct Landmark : public LandmarkState
 {
-	LandmarkId id{0};
-	Eigen::Vector3d p_world{Eigen::Vector3d::Zero()};
-	/** Representative descriptor: the one with the least median distance to the others. */
-	cv::Mat descriptor;
-	/** keyframe -> index of the keypoint observing this landmark there */
-	std::map<KeyFrameId, int> observations;
-	/** Mean viewing direction (unit, world frame, from cameras towards the point). */
-	Eigen::Vector3d normal{Eigen::Vector3d::Zero()};
-	/** Distances within which ORB's scale invariance holds [m]. */
-	double minDistance{0}, maxDistance{0};
-	KeyFrameId firstKeyFrame{0};
-	/** Frames where it was predicted in view / actually matched (for culling). */
-	int visibleCount{1}, foundCount{1};
 	/** Histogram of Oriented Cameras (used when [hoc] enabled; see HocFrontend.h). */
 	maps::HocHistogram hoc;
 

@@ -2,6 +2,7 @@
 /** \file TrackerOptions.h
  * Parameters of frame tracking and keyframe selection.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/maps/HocHistogram.h>
 #include <keygrid/sfm/Matcher.h>
@@ -12,14 +13,9 @@
 #include <string>
 #include <vector>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::sfm
 {
-struct TrackerOptions
+struct TrackerOptions : public core::FieldTableOptions<TrackerOptions>
 {
 	/** Keypoints with valid depth needed to initialise the map (Default: 300) */
 	int minInitFeatures{300};
@@ -102,8 +98,6 @@ struct TrackerOptions
 
 	/** The [tracker] keys (without [hoc] and [monocular], which are sections of their own). */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "tracker") const;
 };

@@ -19,6 +19,7 @@
  *    before its points are triangulated: the linear estimates are several times less accurate
  *    than the noise allows.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/RgbdReprojectionCost.h>
 #include <keygrid/sfm/TwoViewGeometry.h>
@@ -32,7 +33,7 @@
 
 namespace keygrid::sfm
 {
-struct TwoViewOptions
+struct TwoViewOptions : public core::FieldTableOptions<TwoViewOptions>
 {
 	/** RANSAC iterations, each one draw of 8 correspondences shared by both models (the
 	 * homography uses its first 4) (Default: 200) */
@@ -87,8 +88,6 @@ struct TwoViewOptions
 
 	/** The INI keys, with description and rule (core/OptionFields.h). */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument("[section] key = value (must be ...)") on a bad value. */
 	void validate(const std::string& section = "two_view") const;
 	/** validate() as a flag, its message in `error`. */

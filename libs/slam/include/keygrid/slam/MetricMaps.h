@@ -30,6 +30,7 @@
  * (applyCorrection's newScales): the maps and the floor estimate scale what they hold in that
  * keyframe's camera frame by it.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/maps/CHOCPointsMap.h>
 #include <keygrid/maps/FloorFrameEstimator.h>
@@ -48,7 +49,7 @@
 namespace keygrid::slam
 {
 /** How keyframes feed the maps ([maps] section). */
-struct MapFeedOptions
+struct MapFeedOptions : public core::FieldTableOptions<MapFeedOptions>
 {
 	/** Input of the 2D ISM grid: "sparse" (the keyframe's map points, as in the paper) or
 	 * "dense" (its depth image) (Default: sparse) */
@@ -56,8 +57,6 @@ struct MapFeedOptions
 
 	/** The [maps] keys. */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "maps") const;
 };

@@ -8,6 +8,7 @@
  * search the floor along the newest stretch of the path (window_path_length). The map alone is
  * rescaled here; the caller (slam::System) moves what refers to it (tracker, frames).
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/CameraHeightScale.h>
 #include <keygrid/sfm/SparseMap.h>
@@ -16,15 +17,10 @@
 #include <string>
 #include <vector>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::slam
 {
 /** [camera_height_scale]: the estimator's keys and how often it runs. */
-struct MetricScaleOptions
+struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 {
 	/** camera_height (0 = unknown: the monocular map keeps an arbitrary scale) and the floor
 	 * search (sfm::CameraHeightScaleOptions). */
@@ -47,8 +43,6 @@ struct MetricScaleOptions
 
 	bool enabled() const { return estimator.cameraHeight > 0; }
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "camera_height_scale") const;
 };

@@ -14,6 +14,7 @@
  * killed run keeps them as of each landmark's last write.
  * The metric maps are stored as snapshots every `snapshot_every` keyframes and at the end.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/sfm/SparseMap.h>
 #include <keygrid/store/SessionWriter.h>
 
@@ -36,7 +37,7 @@ namespace keygrid::slam
 class MetricMaps;
 
 /** INI section [store]: the session file of keygrid-slam --map / --load-map. */
-struct SessionRecorderOptions
+struct SessionRecorderOptions : public core::FieldTableOptions<SessionRecorderOptions>
 {
 	/** Store each keyframe's colour and depth images (needed to rebuild the dense maps and for
 	 * keyframes.simplemap of an exported session) (Default: true) */
@@ -59,9 +60,6 @@ struct SessionRecorderOptions
 
 	/** The [store] keys, SQLite's and the image codec's included. */
 	core::OptionFields fields();
-	/** Throws std::invalid_argument naming the key when a value is invalid. */
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "store") const;
 };

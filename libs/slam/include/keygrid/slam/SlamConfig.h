@@ -10,6 +10,7 @@
  * (the floor frame every map output is written in), [store] (the session file of --map) and [MappingApplication] (the maps themselves, MRPT's
  * CMultiMetricMap format, see MetricMaps). Keys absent from the file keep their documented defaults.
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/loop/LoopCloser.h>
 #include <keygrid/sfm/FeatureExtractor.h>
 #include <keygrid/sfm/LocalMapper.h>
@@ -23,7 +24,7 @@
 namespace keygrid::slam
 {
 /** Batch refinement after the last frame (file inputs). */
-struct RefinementOptions
+struct RefinementOptions : public core::FieldTableOptions<RefinementOptions>
 {
 	/** Bundle-adjust all keyframes and landmarks at the end (Default: true) */
 	bool globalBundleAdjustment{true};
@@ -60,8 +61,6 @@ struct RefinementOptions
 
 	/** The [refinement] keys. */
 	core::OptionFields fields();
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "refinement") const;
 };

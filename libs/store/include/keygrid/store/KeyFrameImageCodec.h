@@ -4,20 +4,15 @@
  * the costly part of storing a keyframe, so it is separate from SessionStore::write(): run it on
  * another thread (SessionWriter does) and hand the EncodedImages over.
  */
-#include <keygrid/store/SessionRecords.h>
-
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
+#include <keygrid/store/SessionRecords.h>
 
 #include <string>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::store
 {
-struct ImageCodecOptions
+struct ImageCodecOptions : public core::FieldTableOptions<ImageCodecOptions>
 {
 	/** Colour image format: "png" (lossless) or "jpg" (lossy, much smaller) (Default: png) */
 	std::string colourFormat{"png"};
@@ -31,9 +26,6 @@ struct ImageCodecOptions
 	core::OptionFields fields();
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "store") const;
-	/** Keys colour_format, png_compression, jpeg_quality; invalid values throw naming the key. */
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 };
 
 class KeyFrameImageCodec

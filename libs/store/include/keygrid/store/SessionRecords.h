@@ -6,6 +6,8 @@
  */
 #include <keygrid/core/RgbdCamera.h>
 #include <keygrid/loop/BowVector.h>
+#include <keygrid/sfm/Ids.h>
+#include <keygrid/sfm/LandmarkState.h>
 #include <mrpt/poses/CPose3D.h>
 #include <opencv2/core.hpp>
 
@@ -17,10 +19,9 @@
 
 namespace keygrid::store
 {
-using KeyFrameId = std::uint64_t;
-using LandmarkId = std::uint64_t;
-/** Landmark id of a keypoint without a landmark (the same value as sfm::kNoLandmark). */
-constexpr LandmarkId kNoLandmark = ~LandmarkId(0);
+using sfm::KeyFrameId;
+using sfm::kNoLandmark;
+using sfm::LandmarkId;
 
 /** Identity of the vocabulary a session's BoW vectors were computed with: localizing in a
  * session with another vocabulary makes its stored BoW vectors meaningless. */
@@ -115,22 +116,9 @@ struct KeyFrameImages
 	cv::Mat depthRaw;
 };
 
-struct LandmarkRecord
+/** A landmark as stored: its state as the frontend holds it, and its HOC bin counts. */
+struct LandmarkRecord : public sfm::LandmarkState
 {
-	LandmarkId id{0};
-	/** Position in the world frame [m] */
-	Eigen::Vector3d p_world{Eigen::Vector3d::Zero()};
-	/** Representative descriptor (one row) */
-	cv::Mat descriptor;
-	/** keyframe -> index of its keypoint observing this landmark */
-	std::map<KeyFrameId, int> observations;
-	/** Mean viewing direction, unit, world frame */
-	Eigen::Vector3d normal{Eigen::Vector3d::Zero()};
-	/** Scale-invariance distance range [m] */
-	double minDistance{0}, maxDistance{0};
-	KeyFrameId firstKeyFrame{0};
-	/** Frames where it was predicted visible / matched */
-	int visibleCount{1}, foundCount{1};
 	/** HOC bin counts n_b (empty: never updated) */
 	std::vector<std::int16_t> hocCounts;
 };

@@ -2,18 +2,14 @@
 /** \file SessionStoreOptions.h
  * How a SessionStore talks to its SQLite file (INI section `[store]`).
  */
+#include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 
 #include <string>
 
-namespace mrpt::config
-{
-class CConfigFileBase;
-}
-
 namespace keygrid::store
 {
-struct SessionStoreOptions
+struct SessionStoreOptions : public core::FieldTableOptions<SessionStoreOptions>
 {
 	/** When a committed write() is on disk, SQLite's `PRAGMA synchronous` in WAL mode:
 	 * - "full": every commit fsyncs the write-ahead log, so a committed keyframe survives a
@@ -37,10 +33,6 @@ struct SessionStoreOptions
 	core::OptionFields fields();
 	/** Throws std::invalid_argument naming section, key, value and rule of an invalid option. */
 	void validate(const std::string& section = "store") const;
-	/** Keys durability, cache_size_kib, busy_timeout_ms, integrity_check; missing keys keep their value; an
-	 * invalid value throws std::invalid_argument naming the key. */
-	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
-	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 };
 
 }  // namespace keygrid::store

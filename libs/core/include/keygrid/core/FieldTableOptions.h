@@ -1,16 +1,17 @@
 #pragma once
 /** \file FieldTableOptions.h
- * The map plugins' option structs (MRPT CLoadableOptions, read by CMultiMetricMap from the
- * `<map>_creationOpts` / `_insertOpts` / `_likelihoodOpts` sections) whose INI keys are one
- * core::OptionFields table: Derived gives `fields()`, and may give its own
- * `validate(section) const` for rules across keys; reading, writing and MRPT's dump follow.
+ * Base of the options structs whose INI keys are one core::OptionFields table (OptionFields.h):
+ * Derived gives `fields()`, and may give its own `validate(section) const` for rules across
+ * keys; reading, writing and MRPT's dump follow. An MRPT CLoadableOptions, so the map plugins'
+ * structs are read by CMultiMetricMap from the `<map>_creationOpts` / `_insertOpts` /
+ * `_likelihoodOpts` sections like MRPT's own.
  */
 #include <keygrid/core/OptionFields.h>
 #include <mrpt/config/CLoadableOptions.h>
 
 #include <string>
 
-namespace keygrid::maps
+namespace keygrid::core
 {
 template <class Derived>
 struct FieldTableOptions : public mrpt::config::CLoadableOptions
@@ -26,10 +27,10 @@ struct FieldTableOptions : public mrpt::config::CLoadableOptions
 	/** Writes every key of the table with its description. */
 	void saveToConfigFile(mrpt::config::CConfigFileBase& target, const std::string& section) const override
 	{
-		core::writeFields(static_cast<const Derived&>(*this), target, section);
+		writeFields(static_cast<const Derived&>(*this), target, section);
 	}
 	/** The table's own rules; a Derived with rules across keys declares its own. */
-	void validate(const std::string& section) const { core::validateFields(static_cast<const Derived&>(*this), section); }
+	void validate(const std::string& section) const { validateFields(static_cast<const Derived&>(*this), section); }
 };
 
-}  // namespace keygrid::maps
+}  // namespace keygrid::core
