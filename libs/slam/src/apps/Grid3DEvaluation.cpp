@@ -66,6 +66,7 @@ Grid3DEvaluationResult evaluateGrid3DAgainstVoxels(
 
 	Grid3DEvaluationResult r;
 	r.resolution = bt.resolution;
+	r.scale = T_gt_est.s;
 	r.floorFrame = bt.T_world_floor.has_value();
 	eval::VoxelMapEstimate est;
 	est.resolution = bt.resolution;
@@ -93,7 +94,10 @@ Grid3DEvaluationResult evaluateGrid3DAgainstVoxels(
 std::string Grid3DEvaluationResult::toText() const
 {
 	std::ostringstream o;
-	o << "3D grid vs true voxels (" << resolution << " m voxels, " << (floorFrame ? "floor frame" : "SLAM world frame") << ", "
+	o << "3D grid vs true voxels (voxels of " << resolution;
+	if (scale != 1) o << " map units = " << resolution * scale << " m";
+	else o << " m";
+	o << ", " << (floorFrame ? "floor frame" : "SLAM world frame") << ", "
 	  << (visibilityKeyframes ? "seen from " + std::to_string(visibilityKeyframes) + " keyframes"
 							  : std::string("no seen mask: every true voxel counts as seen"))
 	  << "):\n"
@@ -105,7 +109,8 @@ std::string Grid3DEvaluationResult::jsonFields() const
 {
 	std::ostringstream o;
 	o << metrics.jsonFields("grid3d_") << ",\n"
-	  << "  \"grid3d_resolution_m\": " << resolution << ",\n"
+	  << "  \"grid3d_resolution\": " << resolution << ",\n"
+	  << "  \"grid3d_voxel_size_m\": " << resolution * scale << ",\n"
 	  << "  \"grid3d_floor_frame\": " << (floorFrame ? "true" : "false") << ",\n"
 	  << "  \"grid3d_visibility_keyframes\": " << visibilityKeyframes;
 	return o.str();

@@ -41,8 +41,10 @@ struct Grid3DEvaluationOptions
 struct Grid3DEvaluationResult
 {
 	eval::VoxelMapMetrics metrics;
-	/** Voxel size of the map [m] */
+	/** Voxel size of the map [its unit: m, or a monocular map's unit] */
 	double resolution{0};
+	/** The alignment's scale: the map's voxels measure resolution * scale in the ground truth */
+	double scale{1};
 	/** Whether the .bt was in a floor frame (else in the SLAM world). */
 	bool floorFrame{false};
 	/** Keyframes rendered for the seen mask (0 = no mask). */
@@ -51,7 +53,8 @@ struct Grid3DEvaluationResult
 	/** Human-readable lines. */
 	std::string toText() const;
 	/** `"grid3d_...": value` lines (no braces) for keygrid-eval's JSON: the fields of
-	 * eval::VoxelMapMetrics::jsonFields, grid3d_resolution_m, grid3d_floor_frame,
+	 * eval::VoxelMapMetrics::jsonFields, grid3d_resolution, grid3d_voxel_size_m (in the ground
+	 * truth, after the alignment's scale), grid3d_floor_frame,
 	 * grid3d_visibility_keyframes. */
 	std::string jsonFields() const;
 };
