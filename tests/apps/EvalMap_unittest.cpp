@@ -6,6 +6,7 @@
 #include <keygrid/sim/Scene.h>
 #include <mrpt/math/CQuaternion.h>
 
+#include "EvalScenes.h"
 #include "TestData.h"
 
 #include <cmath>
@@ -122,14 +123,7 @@ TEST(EvalTool, MapModeVisibilityFromAShippedScene)
 	const auto scene = keygrid::sim::Scene::loadFromFile(scenePath);
 	const auto fp = keygrid::sim::floorPlanOfStaticScene(scene, 0.05, 0.1, 1.8);
 	fp.save(dir + "/plan");
-	keygrid::core::Trajectory gt, kfs;
-	for (std::size_t i = 0; i < scene.options.frames; i++)
-	{
-		gt.push_back({scene.timestamp(i), scene.cameraPose(i)});
-		if (i % 50 == 0) kfs.push_back(gt.back());
-	}
-	keygrid::core::writeTumTrajectory(dir + "/gt.txt", gt);
-	keygrid::core::writeTumTrajectory(dir + "/kf.txt", kfs);
+	keygrid::test::writeSceneTrajectory(scene, dir);
 	const mrpt::poses::CPose3D I;
 	// The map's lattice starts at (0, 0); the plan's may start one cell lower.
 	const int ox = static_cast<int>(std::lround(fp.origin.x() / 0.05)), oy = static_cast<int>(std::lround(fp.origin.y() / 0.05));

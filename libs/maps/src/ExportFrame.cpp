@@ -17,6 +17,19 @@ std::string floorFrameComment(const mrpt::poses::CPose3D& T_world_floor)
 	return buf;
 }
 
+std::optional<mrpt::poses::CPose3D> floorFrameFromComment(const std::string& line)
+{
+	const std::string tag = "keygrid T_world_floor";
+	const auto at = line.find(tag);
+	if (at == std::string::npos || line.find_first_not_of("#comment \t") < at) return std::nullopt;
+	const auto colon = line.find(':', at);
+	if (colon == std::string::npos) return std::nullopt;
+	double v[7];
+	std::istringstream is(line.substr(colon + 1));
+	if (!(is >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5] >> v[6])) return std::nullopt;
+	return mrpt::poses::CPose3D(mrpt::math::CQuaternionDouble(v[6], v[3], v[4], v[5]), v[0], v[1], v[2]);
+}
+
 std::string poseMatrixText(const mrpt::poses::CPose3D& p)
 {
 	const auto R = p.getRotationMatrix();

@@ -1,5 +1,5 @@
+#include <keygrid/maps/ExportFrame.h>
 #include <keygrid/maps/OccupancyGridMetrics.h>
-#include <mrpt/math/CQuaternion.h>
 
 #include <cmath>
 #include <fstream>
@@ -326,13 +326,9 @@ TriStateGrid TriStateGrid::loadRosMapServer(const std::string& yamlPath)
 		}
 		else if (line.rfind("resolution:", 0) == 0)
 			haveRes = static_cast<bool>(std::istringstream(line.substr(11)) >> t.resolution);
-		else if (line.rfind("# keygrid T_world_floor", 0) == 0 && line.find(':') != std::string::npos)
+		else if (line.rfind("# keygrid T_world_floor", 0) == 0)
 		{
-			double v[7];
-			std::istringstream is(line.substr(line.find(':') + 1));
-			if (is >> v[0] >> v[1] >> v[2] >> v[3] >> v[4] >> v[5] >> v[6])
-				t.T_world_floor = mrpt::poses::CPose3D(
-					mrpt::math::CQuaternionDouble(v[6], v[3], v[4], v[5]), v[0], v[1], v[2]);
+			if (auto T = floorFrameFromComment(line)) t.T_world_floor = T;
 		}
 		else if (line.rfind("origin:", 0) == 0)
 		{

@@ -13,7 +13,10 @@
 # map mode, the scorer of the RGB-D grids (tests/benchmarks/maps_ism/nav_safety_sim.sh): hazard
 # cells (interior obstacle cells called free), every obstacle cell called free, obstacle recall
 # over the boundary cells seen and obstacle precision. Without a height the grid is in the map's
-# arbitrary unit and is not scored.
+# arbitrary unit and is not scored. On the rendered scenes the 3D grid (map_3d.bt) is scored
+# against the scene's true voxels (occupancy_voxels.txt) by keygrid-eval's 3D grid mode, after
+# SE(3) alignment with a height, Sim(3) without: occupied voxels, precision, recall over the true
+# voxels the keyframes saw within 4 m, hazard voxels (true voxels called free, no map voxel near).
 # Renderings are made once per --out folder; the TUM cases are skipped when their data is absent.
 #
 #   tests/benchmarks/slam/monocular.sh [--build DIR] [--out DIR] [--cases "room office fr1 desk"] [--help]
@@ -40,7 +43,8 @@ render() {
 }
 
 # run TAG CONFIG INPUT GT HEIGHT [SCENE [SET]]: one keygrid-slam run and its table row; SCENE (a
-# config/sim scene rendered into the folder of GT) has its 2D grid scored when HEIGHT is given
+# config/sim scene rendered into the folder of GT) has its 3D grid scored, its 2D grid when HEIGHT
+# is given
 run() {
   local tag="$1" cfg="$2" input="$3" gt="$4" height="$5" scene="${6:-}" set="${7:-}"
   local dir="$out/run_$tag"
@@ -75,9 +79,18 @@ PY
       --keyframes "$dir/keyframes.txt" --overlay "$dir/overlay.png" --json "$grid" >"$dir/eval_map.txt" 2>&1 \
       || echo "monocular.sh: grid scoring failed: $dir/eval_map.txt" >&2
   fi
-  /usr/bin/python3 - "$dir/report.json" "$gt" "$tag" "$height" "$sim3" "$se3" "$dir/trajectory_tracked.txt" "$grid" <<'PY'
+  local grid3d="$dir/eval_grid3d.json"
+  if [ -n "$scene" ] && [ -f "$dir/map_3d.bt" ]; then
+    local align=""
+    [ "$height" = 0 ] && align="--sim3"
+    "$build/bin/keygrid-eval" --quiet --gt "$gt" --est "$dir/trajectory.txt" $align --grid3d "$dir/map_3d.bt" \
+      --voxels "$(dirname "$gt")/occupancy_voxels.txt" --scene "$root/config/sim/$scene.ini" \
+      --keyframes "$dir/keyframes.txt" --json "$grid3d" >"$dir/eval_grid3d.txt" 2>&1 \
+      || echo "monocular.sh: 3D grid scoring failed: $dir/eval_grid3d.txt" >&2
+  fi
+  /usr/bin/python3 - "$dir/report.json" "$gt" "$tag" "$height" "$sim3" "$se3" "$dir/trajectory_tracked.txt" "$grid" "$grid3d" <<'PY'
 import json, math, os, re, sys
-report, gt, tag, height, sim3, se3, traj, grid = sys.argv[1:9]
+report, gt, tag, height, sim3, se3, traj, grid, grid3d = sys.argv[1:10]
 r = json.load(open(report))
 def rows(path):
     if not os.path.exists(path): return []
@@ -105,24 +118,29 @@ if os.path.exists(grid):
     e = json.load(open(grid))
     grid_text = (f"{e['map_hazard_cells']} of {e['map_interior_obstacle_cells']} | {e['map_obstacle_called_free_cells']} "
                  f"| {e['map_boundary_recall']:.3f} ({e['map_boundary_cells_seen']} seen) | {e['map_obstacle_precision']:.3f}")
+grid3d_text = "- | - | - | -"
+if os.path.exists(grid3d):
+    e = json.load(open(grid3d))
+    grid3d_text = (f"{e['grid3d_occupied_voxels']} | {e['grid3d_precision']:.3f} "
+                   f"| {e['grid3d_recall_seen']:.3f} ({e['grid3d_true_voxels_seen']} seen) | {e['grid3d_hazard_voxels']}")
 print(f"| {tag} | {height if height != '0' else '-'} | {start if start is not None else 'never'} "
       f"| {tracked_after} / {after} | {sim3_text} | {se3_text} | {scale_err} | {r.get('fps', 0):.1f} | {path:.2f} m "
-      f"| {grid_text} |")
+      f"| {grid_text} | {grid3d_text} |")
 PY
 }
 
-echo "| run | camera_height [m] | map start (frame) | tracked after it | ATE, Sim(3) (share of the path) | ATE, SE(3) | scale error | fps | ground-truth path | 2D grid: hazard cells (interior) | obstacle cells called free | obstacle recall, seen boundary | obstacle precision |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| run | camera_height [m] | map start (frame) | tracked after it | ATE, Sim(3) (share of the path) | ATE, SE(3) | scale error | fps | ground-truth path | 2D grid: hazard cells (interior) | obstacle cells called free | obstacle recall, seen boundary | obstacle precision | 3D grid: occupied voxels | voxel precision | voxel recall, seen | hazard voxels |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 mono="$root/config/sim_monocular.ini"
 for c in $cases; do
   case "$c" in
     room)
       d="$(render room_loop room_loop)"
-      run room_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0
+      run room_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0 room_loop
       run room_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.30 room_loop ;;
     office)
       d="$(render office_loop office_loop)"
-      run office_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0
+      run office_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0 office_loop
       run office_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.40 office_loop ;;
     fr1|desk)
       seq=tum_fr1_rpy_first250; [ "$c" = desk ] && seq=tum_fr1_desk_9frames

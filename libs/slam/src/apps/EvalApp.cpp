@@ -2,6 +2,7 @@
 #include <keygrid/eval/TrajectoryErrors.h>
 #include <keygrid/slam/apps/AppRunner.h>
 #include <keygrid/slam/apps/EvalApp.h>
+#include <keygrid/slam/apps/Grid3DEvaluation.h>
 #include <keygrid/slam/apps/MapEvaluation.h>
 #include <keygrid/core/AtomicOutput.h>
 #include <mrpt/math/CMatrixFixed.h>
@@ -32,19 +33,27 @@ core::CommandLine evalCommandLine()
 		"floor plan, carried into the ground-truth world by the same alignment: hazard cells\n"
 		"(obstacles called free), obstacle recall over the boundary cells the cameras saw,\n"
 		"obstacle precision, free-space F1, the floor estimate's error; --overlay draws the\n"
-		"map over the plan (colours: doc/maps-ism2d.md).");
+		"map over the plan (colours: doc/maps-ism2d.md).\n"
+		"With --grid3d and --voxels it scores keygrid-slam's 3D grid (map_3d.bt) against\n"
+		"keygrid-sim's true occupied voxels, carried over by the same alignment (SE(3), or\n"
+		"Sim(3) with --sim3): occupied-voxel precision, recall over the true voxels the keyframe\n"
+		"cameras saw (--scene, --keyframes, --voxel-max-range), true voxels called free and the\n"
+		"hazards among them (no map voxel within --tolerance). Both maps may be scored at once.");
 	cl.option("gt", "GT.txt", "ground-truth trajectory (TUM format)", true)
 		.option("est", "EST.txt", "estimated trajectory (TUM format)", true)
-		.option("json", "OUT.json", "also write the results as JSON (keys ate_rmse_m, rpe_trans_m_per_s, rpe_rot_deg_per_s, matched, ...; map_* with --map)")
+		.option("json", "OUT.json", "also write the results as JSON (keys ate_rmse_m, rpe_trans_m_per_s, rpe_rot_deg_per_s, matched, ...; map_* with --map, grid3d_* with --grid3d)")
 		.option("max-dt", "SECONDS", "largest timestamp difference for a match", false, "0.02")
 		.option("delta", "SECONDS", "RPE time step", false, "1.0")
 		.option("map", "MAP_2D.yaml", "keygrid-slam's 2D grid (its first line holds the floor pose) to score; needs --floorplan")
 		.option("floorplan", "PLAN.yaml", "keygrid-sim's ground-truth floor plan (floorplan.yaml)")
-		.option("scene", "SCENE.ini", "with --keyframes: render the scene at the keyframes' ground-truth poses to know which cells the cameras saw")
+		.option("scene", "SCENE.ini", "with --keyframes: render the scene at the keyframes' ground-truth poses to know which cells (voxels) the cameras saw")
 		.option("keyframes", "KF.txt", "keyframe timestamps (keygrid-slam's keyframes.txt), with --scene")
 		.option("overlay", "OUT.png", "write the map laid over the floor plan (occupied / free / missed / hazard / false obstacle)")
-		.option("tolerance", "M", "occupied cells match within this distance", false, "0.05")
-		.option("max-range", "M", "horizontal range of the cameras' view for --scene", false, "4.5")
+		.option("tolerance", "M", "occupied cells (voxels) match within this distance", false, "0.05")
+		.option("max-range", "M", "horizontal range of the cameras' view for --map with --scene", false, "4.5")
+		.option("grid3d", "MAP_3D.bt", "keygrid-slam's 3D grid (OctoMap binary; its header holds the floor pose) to score; needs --voxels")
+		.option("voxels", "VOXELS.txt", "keygrid-sim's ground-truth occupied voxels (occupancy_voxels.txt)")
+		.option("voxel-max-range", "M", "distance from the camera within which a rendered surface counts as seen, for --grid3d with --scene", false, "4.0")
 		.option("map-run-gt", "GT1.txt", "with --map-run-est: measure --est in a stored map's frame, fixed by the mapping run's poses (orientations and positions) against this ground truth (localization runs: not re-aligned)")
 		.option("map-run-est", "EST1.txt", "the mapping run's trajectory (keygrid-slam --map), with --map-run-gt")
 		.flag("sim3", "align with scale (for monocular or scale-drifting estimates)")
@@ -72,8 +81,11 @@ MapEvaluationOptions mapEvaluationOptions(const core::CommandLine& cl, const eva
 	MapEvaluationOptions mo;
 	if (!cl.has("map"))
 	{
-		for (const std::string k : {"floorplan", "scene", "keyframes", "overlay"})
+		for (const std::string k : {"floorplan", "overlay"})
 			if (cl.has(k)) throw core::CommandLineError("--" + k + " needs --map");
+		if (!cl.has("grid3d"))
+			for (const std::string k : {"scene", "keyframes"})
+				if (cl.has(k)) throw core::CommandLineError("--" + k + " needs --map or --grid3d");
 		return mo;
 	}
 	if (!cl.has("floorplan")) throw core::CommandLineError("--map needs --floorplan");
@@ -93,6 +105,32 @@ MapEvaluationOptions mapEvaluationOptions(const core::CommandLine& cl, const eva
 	if (!mo.visibility.isValid(&why)) throw core::CommandLineError("--max-range: " + why);
 	return mo;
 }
+
+/** The 3D grid scoring options of --grid3d (which needs --voxels); without --grid3d, --voxels
+ * is a command-line error. */
+Grid3DEvaluationOptions grid3dEvaluationOptions(const core::CommandLine& cl, const eval::TrajectoryErrorOptions& opts)
+{
+	Grid3DEvaluationOptions go;
+	if (!cl.has("grid3d"))
+	{
+		if (cl.has("voxels")) throw core::CommandLineError("--voxels needs --grid3d");
+		return go;
+	}
+	if (!cl.has("voxels")) throw core::CommandLineError("--grid3d needs --voxels");
+	if (cl.has("scene") != cl.has("keyframes")) throw core::CommandLineError("--scene and --keyframes go together");
+	go.gridBt = cl.get("grid3d");
+	go.voxelsPath = cl.get("voxels");
+	go.scenePath = cl.has("scene") ? cl.get("scene") : "";
+	go.keyframesPath = cl.has("keyframes") ? cl.get("keyframes") : "";
+	go.metrics.matchTolerance = cl.getDouble("tolerance");
+	go.maxRange = cl.getDouble("voxel-max-range");
+	go.maxDt = opts.maxDt;
+	go.progress = !cl.flagSet("quiet");
+	std::string why;
+	if (!go.metrics.isValid(&why)) throw core::CommandLineError("--tolerance: " + why);
+	if (!go.isValid(&why)) throw core::CommandLineError("--voxel-max-range: " + why);
+	return go;
+}
 }  // namespace
 
 int EvalApp::run(int argc, const char* const* argv)
@@ -103,6 +141,8 @@ int EvalApp::run(int argc, const char* const* argv)
 		eval::TrajectoryErrorOptions opts = trajectoryErrorOptions(cl);
 		const bool mapMode = cl.has("map");
 		const MapEvaluationOptions mo = mapEvaluationOptions(cl, opts);
+		const bool grid3dMode = cl.has("grid3d");
+		const Grid3DEvaluationOptions go = grid3dEvaluationOptions(cl, opts);
 
 		core::TrajectoryReadOptions ro;
 		ro.skipBadLines = cl.flagSet("skip-bad-lines");
@@ -126,6 +166,12 @@ int EvalApp::run(int argc, const char* const* argv)
 			std::cout << m.toText();
 			if (!mo.overlayPath.empty()) std::cout << "overlay: " << mo.overlayPath << "\n";
 			json = mergeJson(json, m.jsonFields());
+		}
+		if (grid3dMode)
+		{
+			const auto g = evaluateGrid3DAgainstVoxels(go, res.alignment, gt);
+			std::cout << g.toText();
+			json = mergeJson(json, g.jsonFields());
 		}
 		if (cl.has("json")) core::writeFileAtomically(cl.get("json"), json);
 		return 0;

@@ -1,9 +1,6 @@
-#include <keygrid/core/ProgressBar.h>
-#include <keygrid/core/TimestampAssociation.h>
 #include <keygrid/sim/GroundTruthOccupancy.h>
-#include <keygrid/sim/Renderer.h>
-#include <keygrid/sim/Scene.h>
 #include <keygrid/sim/SequenceWriter.h>
+#include <keygrid/slam/apps/KeyFrameViews.h>
 #include <keygrid/slam/apps/MapEvaluation.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/io/vector_loadsave.h>
@@ -28,7 +25,6 @@ maps::FloorPlanGrid toFloorPlanGrid(const sim::FloorPlan& fp)
 std::size_t markVisibility(maps::FloorPlanGrid& gt, const MapEvaluationOptions& o, const core::Trajectory& gtTraj)
 {
 	if (!mrpt::system::fileExists(o.scenePath)) throw std::runtime_error("scene file '" + o.scenePath + "' does not exist");
-	const sim::Scene scene = sim::Scene::loadFromFile(o.scenePath);
 	maps::FloorPlanVisibilityOptions vis = o.visibility;
 	{
 		const mrpt::config::CConfigFileMemory cfg(mrpt::io::file_get_contents(o.scenePath));
@@ -37,27 +33,14 @@ std::size_t markVisibility(maps::FloorPlanGrid& gt, const MapEvaluationOptions& 
 		vis.zMin = out.floorPlanZMin;
 		vis.zMax = out.floorPlanZMax;
 	}
-	const core::Trajectory kfs = core::readTumTrajectory(o.keyframesPath);
-	std::vector<double> tk, tg;
-	for (const auto& k : kfs) tk.push_back(k.t);
-	for (const auto& g : gtTraj) tg.push_back(g.t);
-	const auto matches = core::associateTimestamps(tk, tg, o.maxDt);
-	if (matches.empty())
-		throw std::runtime_error(
-			"no keyframe of '" + o.keyframesPath + "' has a ground-truth pose within " + std::to_string(o.maxDt) + " s");
-	const sim::Renderer renderer(scene);
-	sim::RenderOutput view;
-	core::ProgressBar bar("visibility", matches.size(), o.progress);
-	std::size_t done = 0;
-	for (const auto& [ik, ig] : matches)
-	{
-		const auto& T_world_cam = gtTraj[ig].T_world_cam;
-		renderer.render(T_world_cam, gtTraj[ig].t - scene.options.startTime, view);
-		maps::markSeenCells(gt, view.depth, scene.camera, T_world_cam, vis);
-		bar.update(++done);
-	}
-	bar.finish();
-	return matches.size();
+	KeyFrameViewsOptions views;
+	views.scenePath = o.scenePath;
+	views.keyframesPath = o.keyframesPath;
+	views.maxDt = o.maxDt;
+	views.progress = o.progress;
+	return renderKeyFrameViews(views, gtTraj, [&](const cv::Mat& depth, const core::RgbdCamera& cam, const mrpt::poses::CPose3D& T_world_cam) {
+		maps::markSeenCells(gt, depth, cam, T_world_cam, vis);
+	});
 }
 
 std::string num(double v)

@@ -6,6 +6,7 @@
  */
 #include <mrpt/poses/CPose3D.h>
 
+#include <optional>
 #include <string>
 
 namespace keygrid::maps
@@ -27,6 +28,10 @@ struct ExportFrame
 /** "keygrid T_world_floor (x y z qx qy qz qw): x y z qx qy qz qw" (%.9g), the metadata line
  * of every map output in the floor frame (the same as map_2d.yaml's first-line comment). */
 std::string floorFrameComment(const mrpt::poses::CPose3D& T_world_floor);
+/** The pose of a floorFrameComment() line, read back from a file's metadata line with or
+ * without its comment marker ("# keygrid T_world_floor ...", "comment keygrid ..."); nullopt
+ * when the line is not one or its seven numbers are missing. */
+std::optional<mrpt::poses::CPose3D> floorFrameFromComment(const std::string& line);
 
 /** A pose as the 12 numbers of its 3x4 matrix [R | t], row by row, with 17 significant digits:
  * poseFromMatrixText() gives back the same rotation matrix and translation bit for bit (yaw,
