@@ -138,8 +138,11 @@ TEST(MetricScale, EstimatesAgainRightAfterARequest)
 	// The map grows by 10 % (as a correction could leave it): not due yet, unless requested.
 	map.rescale(1.1);
 	EXPECT_FALSE(scale.update(map).has_value());
+	EXPECT_FALSE(scale.estimateRequested());
 	scale.requestEstimate();
+	EXPECT_TRUE(scale.estimateRequested());
 	const auto s = scale.update(map);
+	EXPECT_FALSE(scale.estimateRequested());
 	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
 	EXPECT_NEAR(*s, 1.0 / 1.1, 1e-6);
 	for (const auto& [id, kf] : map.keyframes()) EXPECT_NEAR(kf.T_world_cam.z(), kCameraHeight, 1e-5);

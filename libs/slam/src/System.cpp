@@ -176,7 +176,7 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 		insertAndCloseLoops(job, &tf);
 	}
 	if (m_extending && !m_startedInStoredMap && !m_startedNewMap) startExtending(tf);
-	if (m_metricScale && tf.newKeyFrame) applyMetricScale(tf);
+	if (m_metricScale && tf.newKeyFrame) applyMetricScale(&tf);
 	tf.mapLandmarks = m_map.numLandmarks();
 	lock.unlock();
 	countFrame(tf);
@@ -240,7 +240,7 @@ void System::logInitialization(const sfm::TrackedFrame& tf)
 	m_initLogSkipped = 0;
 }
 
-void System::applyMetricScale(sfm::TrackedFrame& tf)
+void System::applyMetricScale(sfm::TrackedFrame* tf)
 {
 	const auto t0 = std::chrono::steady_clock::now();
 	const auto s = m_metricScale->update(m_map);
@@ -250,8 +250,11 @@ void System::applyMetricScale(sfm::TrackedFrame& tf)
 	m_map.noteCorrection();
 	m_correctionsSeen = m_map.corrections();
 	m_tracker.onMapRescaled(*s);
-	sfm::scaleTranslation(tf.T_world_cam, *s);
-	sfm::scaleTranslation(tf.T_ref_cam, *s);
+	if (tf)
+	{
+		sfm::scaleTranslation(tf->T_world_cam, *s);
+		sfm::scaleTranslation(tf->T_ref_cam, *s);
+	}
 	for (auto& f : m_frames)
 	{
 		sfm::scaleTranslation(f.T_world_cam, *s);
@@ -556,6 +559,12 @@ void System::finish()
 	}
 	if (m_finished || !m_K || m_map.numKeyFrames() == 0) return;
 	m_finished = true;
+	// A loop correction near the end asked for a new scale estimate that no keyframe came to run.
+	if (m_metricScale && m_metricScale->estimateRequested())
+	{
+		std::lock_guard<std::mutex> lock(m_map.mutex());
+		applyMetricScale(nullptr);
+	}
 	// Keyframe poses before the refinement (erased keyframes via their parents).
 	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> before;
 	for (const auto& [id, kf] : m_map.keyframes()) before[id] = kf.T_world_cam;  // also a loaded map's

@@ -62,6 +62,8 @@ class MetricScale
 	 * map's first keyframe): the next update() estimates, whenever the last estimate was. The
 	 * caller holds the map's lock. */
 	void requestEstimate() { m_lastEstimateAt.reset(); }
+	/** The map is metric and an estimate was requested that no update() has run yet. */
+	bool estimateRequested() const { return metric() && !m_lastEstimateAt; }
 
 	struct Stats
 	{

@@ -198,7 +198,9 @@ class System
 	/** Monocular with camera_height, after a new keyframe (map lock held): the map rescaled
 	 * when an estimate is due and succeeds, with the tracker, the frames (`tf`, the current
 	 * one, included) and the path length. */
-	void applyMetricScale(sfm::TrackedFrame& tf);
+	/** Runs MetricScale::update and moves what refers to the map by its factor: the frames, the
+	 * tracker, the maps and `tf` (the frame being tracked; null at the end of the run). */
+	void applyMetricScale(sfm::TrackedFrame* tf);
 	/** Monocular map start: the frame that became the first keyframe references it now. */
 	void attachInitialKeyFrame(const sfm::TrackedFrame& tf);
 	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
