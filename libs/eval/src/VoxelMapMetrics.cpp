@@ -74,7 +74,7 @@ long VoxelTruth::find(const VoxelIndex& v) const
 
 int VoxelTruth::markSeen(const Eigen::Vector3d& p_world)
 {
-	constexpr double kFace = 1e-3;
+	constexpr double kFace = 1e-3;  // [m]: a point this close to a voxel face lies on it
 	const VoxelIndex base = indexOf(p_world);
 	// The axes along which p lies within 1 mm of a face, and the neighbour across it.
 	std::array<int, 3> across{0, 0, 0};

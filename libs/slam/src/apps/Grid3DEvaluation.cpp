@@ -15,10 +15,8 @@ namespace
 eval::Similarity3 mapInGroundTruth(const eval::Similarity3& T_gt_est, const mrpt::poses::CPose3D& T_est_map)
 {
 	eval::Similarity3 T = T_gt_est;
-	const auto R = T_est_map.getRotationMatrix().asEigen();
-	const Eigen::Vector3d t(T_est_map.x(), T_est_map.y(), T_est_map.z());
-	T.R = T_gt_est.R * R;
-	T.t = T_gt_est.s * (T_gt_est.R * t) + T_gt_est.t;
+	T.R = T_gt_est.R * T_est_map.getRotationMatrix().asEigen();
+	T.t = T_gt_est.apply(Eigen::Vector3d(T_est_map.x(), T_est_map.y(), T_est_map.z()));
 	return T;
 }
 

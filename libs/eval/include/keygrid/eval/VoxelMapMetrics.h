@@ -11,7 +11,7 @@
  *   cells: an obstacle the map has nowhere near where it says free).
  * Distances are measured on the ground truth's lattice: a map voxel counts at the true voxel its
  * centre falls in, and two voxels match when their centres are at most the tolerance apart
- * (0.05 m on 5 cm voxels: the voxel and its 6 face neighbours).
+ * (a tolerance of one voxel size: the voxel and its 6 face neighbours).
  * Plain voxel lists, so the simulator's and the maps' types stay out of libs/eval.
  */
 #include <keygrid/eval/Alignment.h>
@@ -53,8 +53,8 @@ class VoxelTruth
 	long find(const VoxelIndex& v) const;
 
 	/** Marks as seen the true voxels a surface point p_world (e.g. of a rendered depth image)
-	 * lies in; a point within 1 mm of a voxel face marks the voxels on both sides (surfaces on
-	 * voxel faces). Returns how many true voxels it marked (new or not). */
+	 * lies in; a point on a voxel face (to a small margin) marks the voxels on both sides
+	 * (surfaces that lie on voxel faces). Returns how many true voxels it marked (new or not). */
 	int markSeen(const Eigen::Vector3d& p_world);
 	/** Whether any voxel was marked: without marks every voxel counts as seen. */
 	bool hasSeenMask() const { return m_anySeen; }
@@ -71,8 +71,8 @@ class VoxelTruth
 
 struct VoxelMapMetricsOptions
 {
-	/** Two voxels match when their centres are at most this far apart [m] (Default: 0.05 m, one
-	 * 5 cm voxel: face neighbours) */
+	/** Two voxels match when their centres are at most this far apart [m]; one voxel size
+	 * matches face neighbours (Default: 0.05 m) */
 	double matchTolerance{0.05};
 
 	bool isValid(std::string* error = nullptr) const;
