@@ -20,11 +20,11 @@ using keygrid::test::runCommand;
 namespace
 {
 /** Writes a map_2d.yaml/.pgm pair the way keygrid-slam does (first line: the floor pose in the
- * SLAM world), 5 cm cells from (0, 0) in the floor frame; state(cx, cy): 0 occupied, 254 free,
- * 205 unknown. */
+ * SLAM world), cells of `resolution` from (0, 0) in the floor frame; state(cx, cy): 0 occupied,
+ * 254 free, 205 unknown. */
 void writeMap(
 	const std::string& stem, int w, int h, const std::function<unsigned char(int, int)>& state,
-	const mrpt::poses::CPose3D* T_world_floor)
+	const mrpt::poses::CPose3D* T_world_floor, double resolution = 0.05)
 {
 	std::ofstream yaml(stem + ".yaml");
 	if (T_world_floor)
@@ -37,15 +37,16 @@ void writeMap(
 		yaml << b;
 	}
 	const std::string image = stem.substr(stem.find_last_of('/') + 1) + ".pgm";
-	yaml << "image: " << image << "\nresolution: 0.05\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.35\n";
+	yaml << "image: " << image << "\nresolution: " << resolution << "\norigin: [0, 0, 0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.35\n";
 	std::ofstream pgm(stem + ".pgm", std::ios::binary);
 	pgm << "P5\n" << w << " " << h << "\n255\n";
 	for (int r = 0; r < h; r++)
 		for (int cx = 0; cx < w; cx++) pgm.put(static_cast<char>(state(cx, h - 1 - r)));
 }
 
-/** A 1.5 s trajectory circling at ~1.3 m, 30 Hz, and the same seen from a SLAM world. */
-void writeTrajectories(const std::string& dir, const mrpt::poses::CPose3D& T_est_gt)
+/** A 1.5 s trajectory circling at ~1.3 m, 30 Hz, and the same seen from a SLAM world whose
+ * unit is 1 / estScale m (a monocular map's arbitrary unit: positions multiplied by estScale). */
+void writeTrajectories(const std::string& dir, const mrpt::poses::CPose3D& T_est_gt, double estScale = 1.0)
 {
 	keygrid::core::Trajectory gt, est;
 	for (int i = 0; i < 45; i++)
@@ -53,7 +54,9 @@ void writeTrajectories(const std::string& dir, const mrpt::poses::CPose3D& T_est
 		const double t = 1700000000.0 + i / 30.0, a = 0.15 * i;
 		const mrpt::poses::CPose3D p(0.5 + 0.3 * std::cos(a), 0.5 + 0.3 * std::sin(a), 1.3 + 0.1 * std::sin(2 * a), a, 0.2, -1.7);
 		gt.push_back({t, p});
-		est.push_back({t, T_est_gt + p});
+		mrpt::poses::CPose3D e = T_est_gt + p;
+		e.x(e.x() * estScale), e.y(e.y() * estScale), e.z(e.z() * estScale);
+		est.push_back({t, e});
 	}
 	keygrid::core::writeTumTrajectory(dir + "/gt.txt", gt);
 	keygrid::core::writeTumTrajectory(dir + "/est.txt", est);
@@ -114,6 +117,45 @@ TEST(EvalTool, MapModeCountsHazardsRecallAndFreeF1ThroughTheAlignment)
 	EXPECT_EQ(std::string(magic + 1, 3), "PNG");
 }
 
+TEST(EvalTool, MapModeWithSim3ScoresAMapInTheEstimatesOwnUnit)
+{
+	// The plan of the test above (a 6 x 6 obstacle in 20 x 20 cells of 5 cm); the SLAM world is
+	// rotated, moved and in half-metres (a monocular run without a metric scale): its map has
+	// the plan's cells at 2.5 cm, and its floor frame's origin is at half the distance.
+	const std::string dir = keygrid::test::scratchDir("eval_map_sim3");
+	keygrid::sim::FloorPlan fp;
+	fp.width = fp.height = 20;
+	fp.occupied.assign(400, 0);
+	auto inBlock = [](int cx, int cy) { return cx >= 7 && cx <= 12 && cy >= 7 && cy <= 12; };
+	for (int cy = 0; cy < 20; cy++)
+		for (int cx = 0; cx < 20; cx++) fp.occupied[cy * 20 + cx] = inBlock(cx, cy);
+	fp.save(dir + "/plan");
+	const mrpt::poses::CPose3D T_est_gt(1.0, -2.0, 0.5, 0.7, 0.2, -0.1);
+	writeTrajectories(dir, T_est_gt, 0.5);
+	mrpt::poses::CPose3D T_world_floor = T_est_gt;
+	T_world_floor.x(0.5), T_world_floor.y(-1.0), T_world_floor.z(0.25);
+	writeMap(dir + "/map_2d", 20, 20, [&](int cx, int cy) -> unsigned char { return inBlock(cx, cy) ? 0 : 254; },
+		&T_world_floor, 0.025);
+	const std::string tool = keygrid::test::toolPath("keygrid-eval");
+	const std::string base = tool + " --gt " + dir + "/gt.txt --est " + dir + "/est.txt --map " + dir +
+		"/map_2d.yaml --floorplan " + dir + "/plan.yaml --json " + dir + "/e.json";
+	std::string out;
+	ASSERT_EQ(runCommand(base + " --sim3", &out), 0) << out;
+	std::string j = keygrid::test::readTextFile(dir + "/e.json");
+	EXPECT_NEAR(jsonNumber(j, "ate_rmse_m"), 0.0, 1e-6) << j;
+	EXPECT_EQ(jsonNumber(j, "map_hazard_cells"), 0);
+	EXPECT_DOUBLE_EQ(jsonNumber(j, "map_obstacle_recall"), 1.0);
+	EXPECT_DOUBLE_EQ(jsonNumber(j, "map_obstacle_precision"), 1.0);
+	EXPECT_DOUBLE_EQ(jsonNumber(j, "map_free_f1"), 1.0);
+	EXPECT_NEAR(jsonNumber(j, "map_floor_offset_m"), 0.0, 1e-6);
+	EXPECT_NEAR(jsonNumber(j, "map_floor_tilt_deg"), 0.0, 1e-4);
+	// A rigid alignment leaves the map at half size on the plan: part of the plan's obstacle
+	// lies under the map's free cells.
+	ASSERT_EQ(runCommand(base, &out), 0) << out;
+	j = keygrid::test::readTextFile(dir + "/e.json");
+	EXPECT_GT(jsonNumber(j, "map_hazard_cells"), 0) << j;
+}
+
 TEST(EvalTool, MapModeVisibilityFromAShippedScene)
 {
 	// room_loop's plan and 9 keyframes at its ground-truth poses; the map is the plan itself
@@ -165,8 +207,6 @@ TEST(EvalTool, MapModeBadInputsGiveOneLineReasons)
 	EXPECT_NE(out.find("--map needs --floorplan"), std::string::npos) << out;
 	EXPECT_EQ(runCommand(base + " --overlay " + dir + "/o.png", &out), 2);
 	EXPECT_NE(out.find("--overlay needs --map"), std::string::npos) << out;
-	EXPECT_EQ(runCommand(base + " --map " + dir + "/nofloor.yaml --floorplan " + dir + "/plan.yaml --sim3", &out), 2);
-	EXPECT_NE(out.find("drop --sim3"), std::string::npos) << out;
 	EXPECT_EQ(runCommand(base + " --map " + dir + "/nofloor.yaml --floorplan " + dir + "/plan.yaml --scene x.ini", &out), 2);
 	EXPECT_NE(out.find("--scene and --keyframes go together"), std::string::npos) << out;
 	EXPECT_EQ(runCommand(base + " --map " + dir + "/nofloor.yaml --floorplan " + dir + "/plan.yaml", &out), 1);

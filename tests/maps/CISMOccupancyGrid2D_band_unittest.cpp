@@ -196,3 +196,26 @@ TEST(CISMOccupancyGrid2D_band, RemovedObstacleIsClearedByRaysThroughIt)
 		for (const auto& T : cams) grid.insertKeyframeDepth(id++, T, room.renderDepth(T, kW, kH, kF));
 	EXPECT_EQ(countState(grid, cells, CellState::Free), cells.size());
 }
+
+/* One floor point 2 m ahead of a camera at 1.4 m: its ray is under obstacleMinHeight (0.10 m)
+ * over its last 2 * 0.10 / 1.4 = 0.143 m, so the floor is seen, and cleared, in the cells from
+ * x = 1.857 m to the point (a cell is cleared when its centre is within the ray's reach).
+ * floorRayMargin = 0.08 m ends the ray at x = 1.92 m: the cells centred at 1.975 and 1.925 m
+ * stay unknown, the one at 1.875 m is still cleared. */
+TEST(CISMOccupancyGrid2D_band, FloorRayMarginKeepsTheCellsAtAFloorPointUncleared)
+{
+	SyntheticRoom room;
+	const auto T = room.cameraPose(0.0, 0.025, 1.4, 0.0, 35 * M_PI / 180);
+	const std::vector<mrpt::math::TPoint3D> floorPoint{{2.0, 0.025, 0.0}};
+	for (const double margin : {0.0, 0.08})
+	{
+		SCOPED_TRACE(margin);
+		auto grid = makeGrid(Model::HeightBand);
+		grid.insertionOptions.floorRayMargin = margin;
+		for (uint64_t id = 0; id < 2; id++) ASSERT_TRUE(grid.insertKeyframePoints(id, T, floorPoint));
+		EXPECT_EQ(grid.stateAt(1.975, 0.025), margin > 0 ? CellState::Unknown : CellState::Free);
+		EXPECT_EQ(grid.stateAt(1.925, 0.025), margin > 0 ? CellState::Unknown : CellState::Free);
+		EXPECT_EQ(grid.stateAt(1.875, 0.025), CellState::Free);
+		EXPECT_EQ(grid.stateAt(1.775, 0.025), CellState::Unknown);  // the ray is 0.16 m high there
+	}
+}

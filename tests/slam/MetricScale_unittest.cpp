@@ -61,7 +61,7 @@ CPose3D circlePose(int k, double height)
 /** A room of 4 x 4 map units: floor points (z = 0) and wall points, observed by keyframe `kf`
  * and, as the frontend triangulates them, by keyframe `witness` from elsewhere (keypoints
  * from `firstKeypoint` on in both). */
-void addRoom(sfm::SparseMap& map, sfm::KeyFrameId kf, sfm::KeyFrameId witness, int firstKeypoint = 0)
+void addRoom(sfm::SparseMap& map, sfm::KeyFrameId kf, sfm::KeyFrameId witness, int firstKeypoint = 0, double floorSlope = 0)
 {
 	std::mt19937 rng(5);
 	// Walls start above the floor's inlier band: their feet would lift the fitted floor.
@@ -72,7 +72,11 @@ void addRoom(sfm::SparseMap& map, sfm::KeyFrameId kf, sfm::KeyFrameId witness, i
 		map.addObservation(map.addLandmark(p, kf, kp), witness, kp);
 		kp++;
 	};
-	for (int i = 0; i < 1500; i++) add({u(rng), u(rng), 0.0});
+	for (int i = 0; i < 1500; i++)
+	{
+		const double x = u(rng);
+		add({x, u(rng), floorSlope * x});
+	}
 	for (int i = 0; i < 1000; i++)
 	{
 		const double along = u(rng);
@@ -230,6 +234,44 @@ TEST(MetricScale, NeedsACameraHeightAndValidOptions)
 	EXPECT_THROW(slam::MetricScale{o}, std::invalid_argument);
 	EXPECT_FALSE(slam::MetricScaleOptions().enabled());
 	EXPECT_TRUE(options().enabled());
+}
+
+// The floor points' plane is tilted by 0.3 deg (their fit, not the truth). Keyframes on a circle
+// of 1 map unit (2.6 m once metric: 1.84 m of spread) at one height: the maps' floor is the
+// plane under the path, camera_height below it. The same keyframes 3 cm (metric) above and
+// below that height in turn (a hand-held camera): the maps' floor is the points' plane.
+TEST(MetricScale, TheMapsFloorLiesUnderALevelCameraPathAndComesFromThePointsOtherwise)
+{
+	const double slope = std::tan(0.3 * M_PI / 180);
+	for (const double wobble : {0.0, 0.03 * kHeightMap / kCameraHeight})
+	{
+		SCOPED_TRACE(wobble);
+		sfm::SparseMap map;
+		const auto pose = [&](int k) {
+			const double a = 0.5 * k;
+			return camera(std::cos(a), std::sin(a), kHeightMap + (k % 2 ? wobble : -wobble), a);
+		};
+		const auto first = map.addKeyFrame(keyFrame(pose(0), 2500)).id;
+		addRoom(map, first, map.addKeyFrame(keyFrame(pose(1), 2500)).id, 0, slope);
+		for (int k = 2; k < 14; k++) map.addKeyFrame(keyFrame(pose(k), 10));
+		slam::MetricScale scale(options());
+		ASSERT_TRUE(scale.update(map).has_value()) << scale.stats().lastMessage;
+		ASSERT_TRUE(scale.floorPlane().has_value());
+		const auto& floor = *scale.floorPlane();
+		ASSERT_EQ(scale.log().size(), 1u);
+		if (wobble == 0)
+		{
+			EXPECT_NEAR(floor.normal.z(), 1.0, 1e-12);
+			EXPECT_NEAR(floor.offset, kCameraHeight - map.keyframe(first).T_world_cam.z(), 1e-9);
+			EXPECT_NE(scale.log()[0].find("floor under the camera path"), std::string::npos) << scale.log()[0];
+		}
+		else
+		{
+			EXPECT_NEAR(std::acos(floor.normal.z()) * 180 / M_PI, 0.3, 0.01);
+			EXPECT_NE(scale.log()[0].find("floor from the map points (camera path: "), std::string::npos)
+				<< scale.log()[0];
+		}
+	}
 }
 
 // A long run whose scale drifted: along a straight path the keyframes and floor of the first

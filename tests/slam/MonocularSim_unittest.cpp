@@ -119,7 +119,7 @@ TEST(MonocularSim, CameraHeightGivesAMetricTrajectory)
 	mo.scenePath = test::dataDir() + "/sim/room_floor_view.ini";
 	mo.keyframesPath = o.output + "/keyframes.txt";
 	const auto se3 = eval::evaluateTrajectory(gt, est, eval::TrajectoryErrorOptions{});
-	const auto m = slam::evaluateMapAgainstFloorPlan(mo, eval::rigidPose(se3.alignment), gt);
+	const auto m = slam::evaluateMapAgainstFloorPlan(mo, se3.alignment, gt);
 	SCOPED_TRACE(m.toText());
 	EXPECT_LT(std::abs(m.floorOffset), 0.02);
 	EXPECT_LT(m.floorTiltDeg, 5.0);
@@ -127,18 +127,20 @@ TEST(MonocularSim, CameraHeightGivesAMetricTrajectory)
 	EXPECT_GE(m.metrics.precision, 0.5);
 	EXPECT_GE(m.metrics.gtBoundarySeenMatched, 40u);
 
-	// The 3D grid from the same map points, in metres on the same floor: every keyframe the 2D
-	// grid took, and its occupied voxels (map_3d.ply, floor frame) between the floor and the
-	// room's 2.6 m ceiling, within what the floor tilt allowed above (5 deg over the room's
-	// 3 m half-extent: 0.26 m).
+	// The 3D grid from the same map points, in metres on the same floor: the keyframes the 2D
+	// grid took that kept map points (sparse_min_parallax_deg leaves none to a few keyframes of
+	// the map start, whose points rest on its short baseline; the 2D grid keeps those keyframes,
+	// the 3D grid has nothing to take from them), and its occupied voxels (map_3d.ply, floor
+	// frame) between the floor and the room's 2.6 m ceiling, within what the floor tilt allowed
+	// above (5 deg over the room's 3 m half-extent: 0.26 m).
 	std::size_t grid2dKeyFrames = 0, grid3dKeyFrames = 0;
 	for (const auto& map : report.at("maps"))
 	{
 		if (map.at("class") == "keygrid::CISMOccupancyGrid2D") grid2dKeyFrames = map.at("keyframes").get<std::size_t>();
 		if (map.at("class") == "keygrid::CSubmappedOccupancyGrid3D") grid3dKeyFrames = map.at("keyframes").get<std::size_t>();
 	}
-	EXPECT_GT(grid3dKeyFrames, 0u);
-	EXPECT_EQ(grid3dKeyFrames, grid2dKeyFrames);
+	EXPECT_LE(grid3dKeyFrames, grid2dKeyFrames);
+	EXPECT_GE(2 * grid3dKeyFrames, grid2dKeyFrames);
 	std::istringstream ply(test::readTextFile(o.output + "/map_3d.ply"));
 	std::string line;
 	while (std::getline(ply, line) && line != "end_header") {}

@@ -100,6 +100,7 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 	const float maxRange2 = static_cast<float>(o.maxRange * o.maxRange);
 	const float hMin = static_cast<float>(o.obstacleMinHeight), hMax = static_cast<float>(o.obstacleMaxHeight);
 	const float fTol = static_cast<float>(o.floorTolerance);
+	const float margin = static_cast<float>(o.floorRayMargin);
 	const float sliceH = static_cast<float>(o.bandSliceHeight);
 	auto sliceOf = [&](float z) { return std::clamp(floorToInt((z - hMin) / sliceH), 0, m_bandSlices - 1); };
 
@@ -127,10 +128,14 @@ void CISMOccupancyGrid2D::integrateRays(const CPose3D& T_world_cam, const std::v
 		const float d2 = dx * dx + dy * dy;
 		if (!(d2 <= maxRange2) || d2 < 1e-12f) continue;  // also drops NaN points
 		Ray r;
-		r.ex = fx;
-		r.ey = fy;
-		r.ez = fz;
 		r.range = std::sqrt(d2);
+		// A floor ray ends floorRayMargin short of its point, on the same 3D line.
+		const float k = obstacle ? 1.0f : (r.range - margin) / r.range;
+		if (!(k > 0.0f)) continue;
+		r.ex = sx + dx * k;
+		r.ey = sy + dy * k;
+		r.ez = sz + (fz - sz) * k;
+		r.range *= k;
 		// Depth along the optical axis drives the noise; the ray is (nearly) horizontal.
 		r.sigma = static_cast<float>(maps::rangeSigma(o.rangeNoise, o.sigmaConstant, p.z));
 		r.obstacle = obstacle;

@@ -42,6 +42,7 @@ void writeOptions(CArchive& out, const CISMOccupancyGrid2D::TInsertionOptions& o
 		<< static_cast<int32_t>(o.minPointsPerCell) << o.occupiedThreshold << o.freeThreshold;
 	out << static_cast<uint8_t>(o.freeSpaceModel) << o.bandSliceHeight;  // since version 1
 	out << o.floorReanchorShift;  // since version 2
+	out << o.floorRayMargin;  // since version 3
 }
 void readOptions(CArchive& in, CISMOccupancyGrid2D::TInsertionOptions& o, uint8_t version)
 {
@@ -76,10 +77,12 @@ void readOptions(CArchive& in, CISMOccupancyGrid2D::TInsertionOptions& o, uint8_
 	// Older grids take the compiled-in default (it only decides future floor changes).
 	o.floorReanchorShift = CISMOccupancyGrid2D::TInsertionOptions().floorReanchorShift;
 	if (version >= 2) in >> o.floorReanchorShift;
+	o.floorRayMargin = 0.0;  // older grids cleared the whole ray
+	if (version >= 3) in >> o.floorRayMargin;
 }
 }  // namespace
 
-uint8_t CISMOccupancyGrid2D::serializeGetVersion() const { return 2; }
+uint8_t CISMOccupancyGrid2D::serializeGetVersion() const { return 3; }
 
 void CISMOccupancyGrid2D::serializeTo(CArchive& out) const
 {
@@ -111,6 +114,7 @@ void CISMOccupancyGrid2D::serializeFrom(CArchive& in, uint8_t version)
 		case 0:
 		case 1:
 		case 2:
+		case 3:
 		{
 			readOptions(in, creationOptions);
 			readOptions(in, insertionOptions, version);

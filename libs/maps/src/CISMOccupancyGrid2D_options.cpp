@@ -85,6 +85,7 @@ core::OptionFields CISMOccupancyGrid2D::TInsertionOptions::fields()
 	f.add("obstacleMinHeight", obstacleMinHeight, "obstacle band above the floor, lower end [m] (> floorTolerance)");
 	f.add("obstacleMaxHeight", obstacleMaxHeight, "obstacle band, upper end [m] (> obstacleMinHeight); points above it are ignored");
 	f.add("floorTolerance", floorTolerance, "points within +- this of the floor are floor: their rays only clear space [m]", R::atLeast(0));
+	f.add("floorRayMargin", floorRayMargin, "a floor point's ray clears space up to this short of the point [m]", R::atLeast(0));
 	f.addCustom(
 		"T_world_floor",
 		{[this](const std::string& text) {

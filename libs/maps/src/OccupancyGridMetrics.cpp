@@ -378,8 +378,9 @@ TriStateGrid TriStateGrid::loadRosMapServer(const std::string& yamlPath)
 }
 
 TriStateGrid resampleTriState(
-	const TriStateGrid& src, const mrpt::poses::CPose3D& T_B_A, const GridLattice& lattice)
+	const TriStateGrid& src, const mrpt::poses::CPose3D& T_B_A, const GridLattice& lattice, double scaleA)
 {
+	if (!(scaleA > 0)) throw std::invalid_argument("resampleTriState: scaleA must be > 0");
 	TriStateGrid out;
 	static_cast<GridLattice&>(out) = lattice;
 	out.cells.assign(out.numCells(), CellState::Unknown);
@@ -389,7 +390,7 @@ TriStateGrid resampleTriState(
 		{
 			double ax, ay, az;
 			T_A_B.composePoint(out.xMin + (cx + 0.5) * out.resolution, out.yMin + (cy + 0.5) * out.resolution, 0.0, ax, ay, az);
-			out.cells[out.cellIndex(cx, cy)] = src.at(ax, ay);
+			out.cells[out.cellIndex(cx, cy)] = src.at(ax / scaleA, ay / scaleA);
 		}
 	return out;
 }

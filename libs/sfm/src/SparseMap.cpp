@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -284,6 +285,22 @@ std::vector<KeyFrameId> SparseMap::bestCovisibles(KeyFrameId id, std::size_t n) 
 	std::vector<KeyFrameId> out;
 	for (std::size_t i = 0; i < v.size() && i < n; i++) out.push_back(v[i].second);
 	return out;
+}
+
+double largestParallaxCos(const SparseMap& map, const Landmark& lm)
+{
+	double minCos = 1.0;
+	std::optional<Eigen::Vector3d> first;
+	for (const auto& [kf, idx] : lm.observations)
+	{
+		if (!map.hasKeyFrame(kf)) continue;
+		const Eigen::Vector3d ray = (lm.p_world - translationOf(map.keyframe(kf).T_world_cam)).normalized();
+		if (!first)
+			first = ray;
+		else
+			minCos = std::min(minCos, first->dot(ray));
+	}
+	return minCos;
 }
 
 }  // namespace keygrid::sfm

@@ -23,6 +23,7 @@ core::OptionFields MapFeedOptions::fields()
 {
 	core::OptionFields f;
 	f.add("ism2d_input", ism2dInput, "input of the 2D ISM grid: sparse (map points) | dense (depth image)", core::OptionRule::oneOf({"sparse", "dense"}));
+	f.add("sparse_min_parallax_deg", sparseMinParallaxDeg, "the maps take map points without depth only when seen under rays this far apart [deg]; 0 = all", core::OptionRule::fromBelow(0, 90));
 	return f;
 }
 
@@ -177,12 +178,16 @@ maps::MapKeyFrame MetricMaps::mapKeyFrame(const sfm::SparseMap& map, sfm::KeyFra
 	out.T_world_cam = kf.T_world_cam;
 	out.camera = kf.features.camera;
 	out.depth = depthOf(kf);
-	for (sfm::LandmarkId l : kf.landmarks)
-		if (l != sfm::kNoLandmark && map.hasLandmark(l))
-		{
-			const auto& p = map.landmark(l).p_world;
-			out.points_world.emplace_back(p.x(), p.y(), p.z());
-		}
+	const double minCos = std::cos(m_feed.sparseMinParallaxDeg * M_PI / 180.0);
+	for (std::size_t i = 0; i < kf.landmarks.size(); i++)
+	{
+		const sfm::LandmarkId l = kf.landmarks[i];
+		if (l == sfm::kNoLandmark || !map.hasLandmark(l)) continue;
+		const auto& lm = map.landmark(l);
+		const bool hasDepth = i < kf.features.depth.size() && kf.features.depth[i] > 0;
+		if (m_feed.sparseMinParallaxDeg > 0 && !hasDepth && !(sfm::largestParallaxCos(map, lm) <= minCos)) continue;
+		out.points_world.emplace_back(lm.p_world.x(), lm.p_world.y(), lm.p_world.z());
+	}
 	out.travelled = travelled;
 	return out;
 }

@@ -1,8 +1,11 @@
 #include <keygrid/slam/MetricScale.h>
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +17,8 @@ core::OptionFields MetricScaleOptions::fields()
 	core::OptionFields f = estimator.fields();
 	f.add("min_point_parallax_deg", minPointParallaxDeg, "map points seen under rays less far apart are left out of the floor search [deg]; 0 = all", core::OptionRule::fromBelow(0, 90));
 	f.add("window_path_length", windowPathLength, "once metric, the floor is searched along this much of the newest path [m]; 0 = whole map", core::OptionRule::atLeast(0));
+	f.add("path_floor_max_rms", pathFloorMaxRms, "the maps' floor is the plane through the keyframe centres, camera_height under it, when they lie this close to one plane [m]; 0 = the floor points' plane", core::OptionRule::atLeast(0));
+	f.add("path_floor_min_spread", pathFloorMinSpread, "... and when the path spreads this far across its main direction [m]", core::OptionRule::atLeast(0));
 	f.add("reestimate_every", reestimateEvery, "after the first estimate, estimate and rescale again every this many keyframes", core::OptionRule::positive());
 	return f;
 }
@@ -26,24 +31,6 @@ void MetricScaleOptions::validate(const std::string& s) const
 
 namespace
 {
-/** Cosine of the largest angle between the rays of the first observing keyframe and each
- * other one towards the landmark (1: seen from one place only). */
-double largestParallaxCos(const sfm::SparseMap& map, const sfm::Landmark& lm)
-{
-	double minCos = 1.0;
-	std::optional<Eigen::Vector3d> first;
-	for (const auto& [kf, idx] : lm.observations)
-	{
-		if (!map.hasKeyFrame(kf)) continue;
-		const auto& t = map.keyframe(kf).T_world_cam;
-		const Eigen::Vector3d ray = (lm.p_world - Eigen::Vector3d(t.x(), t.y(), t.z())).normalized();
-		if (!first) first = ray;
-		else
-			minCos = std::min(minCos, first->dot(ray));
-	}
-	return minCos;
-}
-
 /** The newest keyframes (ascending ids) whose centres span `pathLength` of the path, in id
  * order; every keyframe when pathLength is 0 or the path is shorter. */
 std::vector<sfm::KeyFrameId> estimateWindow(const sfm::SparseMap& map, double pathLength)
@@ -72,6 +59,48 @@ bool observedFrom(const sfm::Landmark& lm, const std::vector<sfm::KeyFrameId>& w
 		if (std::binary_search(window.begin(), window.end(), obs.first)) return true;
 	return false;
 }
+
+/** A plane through the path steeper than this against the floor points' plane is no floor. */
+constexpr double kMaxPathFloorTiltDeg = 5.0;
+
+/** The floor under a camera moving at camera_height: the least-squares plane through every
+ * keyframe centre (its normal is the direction of least spread of the centres, turned to
+ * `up`), moved camera_height down; nullopt with the reason in `why` when the path is not level
+ * enough (RMS distance to the plane), too narrow, or tilted against `up`. */
+std::optional<MetricScale::FloorPlane> floorUnderThePath(
+	const sfm::SparseMap& map, const Eigen::Vector3d& up, const MetricScaleOptions& o, std::string& why)
+{
+	if (!(o.pathFloorMaxRms > 0))
+	{
+		why = "floor from the map points";
+		return std::nullopt;
+	}
+	Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+	for (const auto& [id, kf] : map.keyframes()) mean += Eigen::Vector3d(kf.T_world_cam.x(), kf.T_world_cam.y(), kf.T_world_cam.z());
+	mean /= static_cast<double>(map.numKeyFrames());
+	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+	for (const auto& [id, kf] : map.keyframes())
+	{
+		const Eigen::Vector3d d = Eigen::Vector3d(kf.T_world_cam.x(), kf.T_world_cam.y(), kf.T_world_cam.z()) - mean;
+		cov += d * d.transpose();
+	}
+	cov /= static_cast<double>(map.numKeyFrames());
+	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);  // eigenvalues ascending
+	const double rms = std::sqrt(std::max(0.0, eig.eigenvalues()(0))), spread = std::sqrt(std::max(0.0, eig.eigenvalues()(1)));
+	Eigen::Vector3d n = eig.eigenvectors().col(0);
+	if (n.dot(up) < 0) n = -n;
+	const double tiltDeg = std::acos(std::min(1.0, n.dot(up.normalized()))) * 180.0 / M_PI;
+	char b[160];
+	std::snprintf(b, sizeof(b), "camera path: %.1f mm off a plane, %.2f m wide, %.2f deg to the floor points' plane", rms * 1e3, spread, tiltDeg);
+	why = b;
+	if (rms > o.pathFloorMaxRms || spread < o.pathFloorMinSpread || tiltDeg > kMaxPathFloorTiltDeg)
+	{
+		why = "floor from the map points (" + why + ")";
+		return std::nullopt;
+	}
+	why = "floor under the " + why;
+	return MetricScale::FloorPlane{n, o.estimator.cameraHeight - n.dot(mean)};
+}
 }  // namespace
 
 MetricScale::MetricScale(const MetricScaleOptions& opts) : m_opts(opts), m_estimator(opts.estimator) { opts.validate(); }
@@ -97,20 +126,25 @@ std::optional<double> MetricScale::update(sfm::SparseMap& map)
 	{
 		if (!wholeMap && !observedFrom(lm, window)) continue;
 		all.push_back(lm.p_world);
-		if (!(largestParallaxCos(map, lm) > minCos)) points.push_back(lm.p_world);
+		if (!(sfm::largestParallaxCos(map, lm) > minCos)) points.push_back(lm.p_world);
 	}
 	auto r = m_estimator.estimate(poses, points);
 	if (!r.ok && points.size() < all.size()) r = m_estimator.estimate(poses, all);
 	m_stats.estimates++;
 	m_stats.lastMessage = r.message;
+	std::string floorSource;
+	if (r.ok)
+	{
+		map.rescale(r.scale);
+		// The plane was found in the map before the rescale: its offset scales with the map.
+		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource)
+						   .value_or(FloorPlane{r.floorNormal, r.floorOffset * r.scale});
+	}
 	if (m_log.size() < kMaxLogLines)
 		m_log.push_back(
 			"keyframe " + std::to_string(newest) + ", " + std::to_string(window.size()) + " keyframes, " + std::to_string(all.size()) +
-			" points: " + (r.ok ? "x" + std::to_string(r.scale) + ", " : "") + r.message);
+			" points: " + (r.ok ? "x" + std::to_string(r.scale) + ", " : "") + r.message + (r.ok ? "; " + floorSource : ""));
 	if (!r.ok) return std::nullopt;
-	map.rescale(r.scale);
-	// The plane was found in the map before the rescale: its offset scales with the map.
-	m_floorPlane = FloorPlane{r.floorNormal, r.floorOffset * r.scale};
 	m_stats.applied++;
 	m_stats.totalFactor *= r.scale;
 	m_stats.lastFactor = r.scale;

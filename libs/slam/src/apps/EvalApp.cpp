@@ -74,7 +74,7 @@ eval::TrajectoryErrorOptions trajectoryErrorOptions(const core::CommandLine& cl)
 	return opts;
 }
 
-/** The map scoring options of --map (which needs --floorplan and an SE(3) alignment); without
+/** The map scoring options of --map (which needs --floorplan); without
  * --map, its companion options are command-line errors. */
 MapEvaluationOptions mapEvaluationOptions(const core::CommandLine& cl, const eval::TrajectoryErrorOptions& opts)
 {
@@ -89,7 +89,6 @@ MapEvaluationOptions mapEvaluationOptions(const core::CommandLine& cl, const eva
 		return mo;
 	}
 	if (!cl.has("floorplan")) throw core::CommandLineError("--map needs --floorplan");
-	if (opts.withScale) throw core::CommandLineError("--map needs an SE(3) alignment: drop --sim3");
 	if (cl.has("scene") != cl.has("keyframes")) throw core::CommandLineError("--scene and --keyframes go together");
 	mo.mapYaml = cl.get("map");
 	mo.floorPlanYaml = cl.get("floorplan");
@@ -162,7 +161,7 @@ int EvalApp::run(int argc, const char* const* argv)
 		std::string json = res.toJson();
 		if (mapMode)
 		{
-			const auto m = evaluateMapAgainstFloorPlan(mo, eval::rigidPose(res.alignment), gt);
+			const auto m = evaluateMapAgainstFloorPlan(mo, res.alignment, gt);
 			std::cout << m.toText();
 			if (!mo.overlayPath.empty()) std::cout << "overlay: " << mo.overlayPath << "\n";
 			json = mergeJson(json, m.jsonFields());

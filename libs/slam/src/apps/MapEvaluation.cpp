@@ -52,7 +52,7 @@ std::string num(double v)
 }  // namespace
 
 MapEvaluationResult evaluateMapAgainstFloorPlan(
-	const MapEvaluationOptions& o, const mrpt::poses::CPose3D& T_gt_est, const core::Trajectory& gtTraj)
+	const MapEvaluationOptions& o, const eval::Similarity3& T_gt_est, const core::Trajectory& gtTraj)
 {
 	if (o.mapYaml.empty() || o.floorPlanYaml.empty())
 		throw std::invalid_argument("map evaluation needs both a map and a floor plan");
@@ -67,12 +67,18 @@ MapEvaluationResult evaluateMapAgainstFloorPlan(
 			"'" + o.mapYaml + "' has no '# keygrid T_world_floor' line (a map_2d.yaml written by keygrid-slam has it)");
 
 	MapEvaluationResult r;
-	const mrpt::poses::CPose3D T_gt_floor = T_gt_est + *est.T_world_floor;
+	// x_gt = s R (T_world_floor p) + t = T_gt_floor (s p), with T_gt_floor = (R R_wf, s R t_wf + t):
+	// the rigid frame of the floor in the ground-truth world, the grid's unit scaled by s.
+	const mrpt::poses::CPose3D& T_wf = *est.T_world_floor;
+	eval::Similarity3 floorFrame;
+	floorFrame.R = T_gt_est.R * T_wf.getRotationMatrix().asEigen();
+	floorFrame.t = T_gt_est.apply(Eigen::Vector3d(T_wf.x(), T_wf.y(), T_wf.z()));
+	const mrpt::poses::CPose3D T_gt_floor = eval::rigidPose(floorFrame);
 	r.floorOffset = T_gt_floor.z();
 	const auto R = T_gt_floor.getRotationMatrix();
 	r.floorTiltDeg = std::acos(std::min(1.0, std::abs(R(2, 2)))) * 180.0 / M_PI;
 
-	const maps::TriStateGrid onPlan = maps::resampleTriState(est, T_gt_floor, gt);
+	const maps::TriStateGrid onPlan = maps::resampleTriState(est, T_gt_floor, gt, T_gt_est.s);
 
 	if (!o.scenePath.empty()) r.visibilityKeyframes = markVisibility(gt, o, gtTraj);
 	r.metrics = maps::evaluateOccupancy(onPlan, gt, o.metrics);

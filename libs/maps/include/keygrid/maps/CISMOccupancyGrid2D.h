@@ -128,6 +128,12 @@ class CISMOccupancyGrid2D : public maps::DepthScanMap, public maps::KeyFrameMap
 		/** Points within +-this of the floor are floor: they clear their ray [m]
 		 * (Default: 0.04 m) */
 		double floorTolerance{0.04};
+		/** A floor point's ray clears space up to this short of the point [m]: the cells at a
+		 * point placed with an error of a few cm (a monocular map point: its triangulation,
+		 * its keyframe's pose) may lie under the obstacle whose foot the point really is;
+		 * the floor right before an obstacle is then only cleared by points beyond it (Default:
+		 * 0 m: the whole ray, for depth images) */
+		double floorRayMargin{0.0};
 		/** Pose of the floor frame (z up) in the world (Default: identity) */
 		mrpt::poses::CPose3D T_world_floor;
 		/** Estimate the floor plane by RANSAC from the first depth image instead of

@@ -251,9 +251,11 @@ void markSeenCells(
 /** Resamples `src` (a grid in floor frame A) onto `lattice` in floor frame B (e.g. a ground
  * truth's): each output cell takes the state of the source cell under its centre (nearest
  * neighbour), the centre (x, y, 0)_B mapped into A by inv(T_B_A) and its A-height dropped (a
- * small tilt between the two floors is ignored; the caller should report it). The result has
- * no T_world_floor. */
+ * small tilt between the two floors is ignored; the caller should report it). `scaleA` is the
+ * length in B of one unit of A (a map in another unit, e.g. a monocular map aligned by a
+ * similarity: a point p_A lies at T_B_A (scaleA p_A)); it must be > 0. The result has no
+ * T_world_floor. */
 TriStateGrid resampleTriState(
-	const TriStateGrid& src, const mrpt::poses::CPose3D& T_B_A, const GridLattice& lattice);
+	const TriStateGrid& src, const mrpt::poses::CPose3D& T_B_A, const GridLattice& lattice, double scaleA = 1.0);
 
 }  // namespace keygrid::maps

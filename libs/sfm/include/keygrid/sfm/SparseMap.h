@@ -146,6 +146,11 @@ class SparseMap
 	mutable std::mutex m_mutex;
 };
 
+/** Cosine of the largest angle between the ray from the landmark's first observing keyframe
+ * (still in the map) and the ray from each other one (1: seen from one place only): how well
+ * its position is triangulated without depth. */
+double largestParallaxCos(const SparseMap& map, const Landmark& lm);
+
 /** Eigen position of a CPose3D translation. */
 inline Eigen::Vector3d translationOf(const mrpt::poses::CPose3D& p) { return {p.x(), p.y(), p.z()}; }
 /** The pose's translation multiplied by s, its rotation kept (a map scaled about its origin). */

@@ -54,6 +54,12 @@ struct MapFeedOptions : public core::FieldTableOptions<MapFeedOptions>
 	/** Input of the 2D ISM grid: "sparse" (the keyframe's map points, as in the paper) or
 	 * "dense" (its depth image) (Default: sparse) */
 	std::string ism2dInput{"sparse"};
+	/** The maps take a keyframe's map points only when their observing keyframes see them
+	 * under rays at least this far apart [deg]; for a monocular map (no depth), where a point
+	 * triangulated over a short baseline lies far along its ray: on the floor it may pass the
+	 * obstacle band or reach under a wall. Points with depth (RGB-D keyframes) always pass;
+	 * 0 = every point (Default: 0) */
+	double sparseMinParallaxDeg{0.0};
 
 	/** The [maps] keys. */
 	core::OptionFields fields();

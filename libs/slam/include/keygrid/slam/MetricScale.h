@@ -40,6 +40,17 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	 * rescales the whole map: it is the scale where the camera is now. The first estimate uses
 	 * the whole map (its units are not metres yet); 0 = always the whole map (Default: 8 m) */
 	double windowPathLength{8.0};
+	/** The maps' floor (floorPlane()) is the plane through the keyframe centres, camera_height
+	 * under it, when the centres lie this close to one plane (RMS distance) [m]: a camera at a
+	 * fixed height on a robot draws the floor's orientation with its whole path, where the
+	 * floor points give it only near the newest stretch (a small tilt there lifts or sinks the
+	 * floor metres away). Otherwise (a hand-held camera) the floor of the estimate; 0 = always
+	 * that one (Default: 0.02 m) */
+	double pathFloorMaxRms{0.02};
+	/** ... and when the path spreads this far across its main direction (the standard deviation
+	 * of the centres along the plane's second axis: a straight path leaves the plane free to
+	 * roll about it) [m] (Default: 1 m) */
+	double pathFloorMinSpread{1.0};
 
 	bool enabled() const { return estimator.cameraHeight > 0; }
 	core::OptionFields fields();
@@ -81,7 +92,9 @@ class MetricScale
 	const std::vector<std::string>& log() const { return m_log; }
 	static constexpr std::size_t kMaxLogLines = 1000;
 	/** The floor plane of the last applied estimate, n . p + offset = 0 in the map as it is
-	 * now (metres; n unit, towards the cameras); nullopt before the first. */
+	 * now (metres; n unit, towards the cameras): the plane under the camera path when the path
+	 * is level and wide enough (pathFloorMaxRms, pathFloorMinSpread), else the floor the
+	 * estimate found among the map points; nullopt before the first. */
 	struct FloorPlane
 	{
 		Eigen::Vector3d normal;

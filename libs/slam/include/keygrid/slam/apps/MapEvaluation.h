@@ -9,6 +9,7 @@
  * It lives in libs/slam because it needs maps, sim and eval (libs/eval must not depend on maps).
  */
 #include <keygrid/core/TumTrajectory.h>
+#include <keygrid/eval/Alignment.h>
 #include <keygrid/maps/OccupancyGridMetrics.h>
 #include <mrpt/poses/CPose3D.h>
 
@@ -65,9 +66,10 @@ struct MapEvaluationResult
 };
 
 /** Scores opts.mapYaml against opts.floorPlanYaml. T_gt_est maps the SLAM world into the
- * ground-truth world (keygrid-eval's SE(3) alignment); gt is the ground-truth trajectory (for the
+ * ground-truth world (keygrid-eval's alignment: SE(3), or Sim(3) for a map in another unit,
+ * whose cells are then scaled by T_gt_est.s); gt is the ground-truth trajectory (for the
  * keyframes' poses). Throws std::runtime_error / std::invalid_argument naming the bad input. */
 MapEvaluationResult evaluateMapAgainstFloorPlan(
-	const MapEvaluationOptions& opts, const mrpt::poses::CPose3D& T_gt_est, const core::Trajectory& gt);
+	const MapEvaluationOptions& opts, const eval::Similarity3& T_gt_est, const core::Trajectory& gt);
 
 }  // namespace keygrid::slam
