@@ -12,7 +12,8 @@
 # points on the camera-height floor) is scored against the scene's floor plan by keygrid-eval's
 # map mode, the scorer of the RGB-D grids (tests/benchmarks/maps_ism/nav_safety_sim.sh): hazard
 # cells (interior obstacle cells called free), every obstacle cell called free, obstacle recall
-# over the boundary cells seen and obstacle precision. Without a height the grid is in the map's
+# over the boundary cells seen and obstacle precision; the hazard cells also after a Sim(3)
+# alignment (the grid's cells scaled with it: what is left without the scale error). Without a height the grid is in the map's
 # arbitrary unit and is not scored. On the rendered scenes the 3D grid (map_3d.bt) is scored
 # against the scene's true voxels (occupancy_voxels.txt) by keygrid-eval's 3D grid mode, after
 # SE(3) alignment with a height, Sim(3) without: occupied voxels, precision, recall over the true
@@ -78,6 +79,10 @@ PY
       --floorplan "$(dirname "$gt")/floorplan.yaml" --scene "$root/config/sim/$scene.ini" \
       --keyframes "$dir/keyframes.txt" --overlay "$dir/overlay.png" --json "$grid" >"$dir/eval_map.txt" 2>&1 \
       || echo "monocular.sh: grid scoring failed: $dir/eval_map.txt" >&2
+    # The same grid after a Sim(3) alignment: what is left once the scale error is taken out.
+    "$build/bin/keygrid-eval" --quiet --gt "$gt" --est "$dir/trajectory.txt" --sim3 --map "$dir/map_2d.yaml" \
+      --floorplan "$(dirname "$gt")/floorplan.yaml" --json "$dir/eval_map_sim3.json" >"$dir/eval_map_sim3.txt" 2>&1 \
+      || echo "monocular.sh: grid scoring (Sim(3)) failed: $dir/eval_map_sim3.txt" >&2
   fi
   local grid3d="$dir/eval_grid3d.json"
   if [ -n "$scene" ] && [ -f "$dir/map_3d.bt" ]; then
@@ -116,7 +121,9 @@ sim3_text = f"{1000 * a_sim3:.1f} mm = {100 * a_sim3 / path:.2f} %" if a_sim3 ==
 grid_text = "- | - | - | -"
 if os.path.exists(grid):
     e = json.load(open(grid))
-    grid_text = (f"{e['map_hazard_cells']} of {e['map_interior_obstacle_cells']} | {e['map_obstacle_called_free_cells']} "
+    sim3_grid = os.path.join(os.path.dirname(grid), "eval_map_sim3.json")
+    after_sim3 = f" ({json.load(open(sim3_grid))['map_hazard_cells']} after Sim(3))" if os.path.exists(sim3_grid) else ""
+    grid_text = (f"{e['map_hazard_cells']} of {e['map_interior_obstacle_cells']}{after_sim3} | {e['map_obstacle_called_free_cells']} "
                  f"| {e['map_boundary_recall']:.3f} ({e['map_boundary_cells_seen']} seen) | {e['map_obstacle_precision']:.3f}")
 grid3d_text = "- | - | - | -"
 if os.path.exists(grid3d):
