@@ -76,7 +76,7 @@ int VoxelTruth::markSeen(const Eigen::Vector3d& p_world)
 {
 	constexpr double kFace = 1e-3;  // [m]: a point this close to a voxel face lies on it
 	const VoxelIndex base = indexOf(p_world);
-	// The axes along which p lies within 1 mm of a face, and the neighbour across it.
+	// The axes along which p lies within kFace of a face, and the neighbour across it.
 	std::array<int, 3> across{0, 0, 0};
 	for (int a = 0; a < 3; a++)
 	{

@@ -41,8 +41,7 @@ std::vector<sfm::KeyFrameId> estimateWindow(const sfm::SparseMap& map, double pa
 	std::optional<Eigen::Vector3d> next;
 	for (auto it = map.keyframes().rbegin(); it != map.keyframes().rend(); ++it)
 	{
-		const auto& t = it->second.T_world_cam;
-		const Eigen::Vector3d c(t.x(), t.y(), t.z());
+		const Eigen::Vector3d c = sfm::translationOf(it->second.T_world_cam);
 		if (next) travelled += (*next - c).norm();
 		if (pathLength > 0 && travelled > pathLength) break;
 		ids.push_back(it->first);
@@ -76,12 +75,12 @@ std::optional<MetricScale::FloorPlane> floorUnderThePath(
 		return std::nullopt;
 	}
 	Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-	for (const auto& [id, kf] : map.keyframes()) mean += Eigen::Vector3d(kf.T_world_cam.x(), kf.T_world_cam.y(), kf.T_world_cam.z());
+	for (const auto& [id, kf] : map.keyframes()) mean += sfm::translationOf(kf.T_world_cam);
 	mean /= static_cast<double>(map.numKeyFrames());
 	Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
 	for (const auto& [id, kf] : map.keyframes())
 	{
-		const Eigen::Vector3d d = Eigen::Vector3d(kf.T_world_cam.x(), kf.T_world_cam.y(), kf.T_world_cam.z()) - mean;
+		const Eigen::Vector3d d = sfm::translationOf(kf.T_world_cam) - mean;
 		cov += d * d.transpose();
 	}
 	cov /= static_cast<double>(map.numKeyFrames());
