@@ -259,6 +259,45 @@ TEST(Sim3PoseGraph, LoopClosureUndoesAScaleDrift)
 	for (int k = 0; k < n; ++k) EXPECT_LT(angleBetween(g.pose(k).q, truth[k].q), 0.01) << k;
 }
 
+// A metric map (setScalesFixed): the loop of the scale-drift test above, but measured at unit
+// scale, as a loop between two metric ends is. The keyframes move towards the truth and no scale
+// changes, where the free graph spreads a scale change over the loop to meet the loop's
+// translation.
+TEST(Sim3PoseGraph, WithFixedScalesALoopMovesKeyFramesButRescalesNone)
+{
+	const int n = 40;
+	const double R = 5, d = 0.99, dth = 2 * M_PI / n;
+	std::vector<Sim3> truth, drifted;
+	for (int k = 0; k < n; ++k)
+	{
+		const double th = k * dth;
+		truth.push_back(makeSim3({0, 0, th + M_PI / 2}, {R * std::cos(th), R * std::sin(th), 0}, 1.0));
+		Sim3 S = truth.back();
+		if (k > 0) S.t = drifted.back().t + std::pow(d, k - 1) * (truth[k].t - truth[k - 1].t);
+		drifted.push_back(S);
+	}
+	for (const bool fixed : {true, false})
+	{
+		SCOPED_TRACE(fixed ? "fixed scales" : "free scales");
+		Sim3PoseGraph g;
+		g.setScalesFixed(fixed);
+		for (int k = 0; k < n; ++k) g.addVertex(k, drifted[k]);
+		for (int k = 0; k + 1 < n; ++k)
+			g.addEdge(Sim3PoseGraphEdge{KeyFrameId(k), KeyFrameId(k + 1), drifted[k].inverse() * drifted[k + 1], Matrix7d::Identity(), EdgeKind::Odometry});
+		g.addEdge(Sim3PoseGraphEdge{KeyFrameId(n - 1), 0, truth[n - 1].inverse() * truth[0], Matrix7d::Identity(), EdgeKind::Loop});
+		const double before = (drifted[n - 1].t - truth[n - 1].t).norm();
+		const auto sum = g.optimize();
+		ASSERT_TRUE(sum.usable) << sum.message;
+		EXPECT_LT((g.pose(n - 1).t - truth[n - 1].t).norm(), 0.5 * before);
+		double furthestScale = 0;
+		for (int k = 0; k < n; ++k) furthestScale = std::max(furthestScale, std::abs(g.pose(k).s - 1.0));
+		if (fixed)
+			EXPECT_EQ(furthestScale, 0.0);
+		else
+			EXPECT_GT(furthestScale, 1e-3);
+	}
+}
+
 TEST(Sim3PoseGraph, RigidCorrectionMovesPointsLikeTheSimilarity)
 {
 	// A keyframe tracked at unit scale, corrected to scale 1.3 with a new pose: a point seen at

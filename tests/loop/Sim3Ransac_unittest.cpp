@@ -140,6 +140,42 @@ TEST(Sim3Ransac, RecoversTheSimilarityWithNoiseAndFortyPercentWrongMatches)
 	}
 }
 
+// A monocular map made metric (fixScale): both sides in metres, the fit is rigid. The scale
+// stays exactly 1 while rotation and translation meet the free fit's bounds; without noise the
+// motion is exact.
+TEST(Sim3Ransac, WithAFixedScaleFitsTheRigidMotionOfAMetricMap)
+{
+	const PinholeIntrinsics K;
+	Scene s = makeScene();
+	s.unitsB = 1.0;
+	Sim3RansacOptions o;
+	o.fixScale = true;
+	std::vector<char> isRight;
+	const auto exact = estimateSim3Ransac(makeMatches(s, K, 60, 0.0, 0.0, 0.0, isRight, 3), K, o);
+	ASSERT_TRUE(exact.success);
+	EXPECT_EQ(exact.numInliers, 60);
+	EXPECT_EQ(exact.S_a_b.s, 1.0);
+	EXPECT_LT(angleDeg(exact.S_a_b.q, s.S_a_b().q), 1e-6);
+	EXPECT_LT((exact.S_a_b.t - s.T_a_b.translation()).norm(), 1e-9);
+	for (std::uint64_t seed : {1u, 2u, 3u})
+	{
+		SCOPED_TRACE("seed " + std::to_string(seed));
+		const auto ms = makeMatches(s, K, 150, 0.7, 0.005, 0.4, isRight, seed);
+		const auto r = estimateSim3Ransac(ms, K, o);
+		ASSERT_TRUE(r.success);
+		EXPECT_EQ(r.S_a_b.s, 1.0);
+		int right = 0, rightFound = 0;
+		for (std::size_t i = 0; i < ms.size(); ++i)
+		{
+			right += isRight[i];
+			rightFound += isRight[i] && r.inlier[i];
+		}
+		EXPECT_GE(rightFound, static_cast<int>(0.9 * right));
+		EXPECT_LT(angleDeg(r.S_a_b.q, s.S_a_b().q), 0.1);
+		EXPECT_LT((r.S_a_b.t - s.T_a_b.translation()).norm(), 0.02);
+	}
+}
+
 TEST(Sim3Ransac, FailsWithTooFewMatchesAndRejectsBadOptions)
 {
 	const PinholeIntrinsics K;

@@ -110,7 +110,7 @@ TEST(MetricScale, RescalesTheMapToTheCameraHeightAndReestimatesEveryNKeyFrames)
 	const auto s = scale.update(map);
 	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
 	// Exact floor and heights: s = camera_height / h_map.
-	EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap) << scale.stats().lastMessage;
+	EXPECT_NEAR(s->factor, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap) << scale.stats().lastMessage;
 	EXPECT_TRUE(scale.metric());
 	for (const auto& [id, kf] : map.keyframes()) EXPECT_NEAR(kf.T_world_cam.z(), kCameraHeight, 1e-5);
 	EXPECT_NEAR(map.landmark(map.keyframe(first).landmarks[100]).p_world.z(), 0.0, 1e-12);  // a floor point stays on z = 0
@@ -123,7 +123,7 @@ TEST(MetricScale, RescalesTheMapToTheCameraHeightAndReestimatesEveryNKeyFrames)
 	map.addKeyFrame(keyFrame(circlePose(21, kCameraHeight), 10));
 	const auto again = scale.update(map);
 	ASSERT_TRUE(again.has_value()) << scale.stats().lastMessage;
-	EXPECT_NEAR(*again, 1.0, 1e-6);
+	EXPECT_NEAR(again->factor, 1.0, 1e-6);
 	EXPECT_EQ(scale.stats().estimates, 2);
 	EXPECT_EQ(scale.stats().applied, 2);
 	EXPECT_NEAR(scale.stats().totalFactor, kCameraHeight / kHeightMap, 1e-5);
@@ -148,7 +148,7 @@ TEST(MetricScale, EstimatesAgainRightAfterARequest)
 	const auto s = scale.update(map);
 	EXPECT_FALSE(scale.estimateRequested());
 	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
-	EXPECT_NEAR(*s, 1.0 / 1.1, 1e-6);
+	EXPECT_NEAR(s->factor, 1.0 / 1.1, 1e-6);
 	for (const auto& [id, kf] : map.keyframes()) EXPECT_NEAR(kf.T_world_cam.z(), kCameraHeight, 1e-5);
 	// The request is used up: the next estimate waits for reestimate_every keyframes again.
 	EXPECT_FALSE(scale.update(map).has_value());
@@ -171,7 +171,7 @@ TEST(MetricScale, IsRetriedAtEveryKeyFrameUntilTheFloorIsFound)
 	addRoom(map, withRoom, first, 10);
 	const auto s = scale.update(map);
 	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
-	EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
+	EXPECT_NEAR(s->factor, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
 	EXPECT_EQ(scale.stats().estimates, 2);
 }
 
@@ -200,7 +200,7 @@ TEST(MetricScale, PointsSeenOverAShortBaselineAreLeftOutOfTheFloorSearch)
 		if (minParallax > 0)
 		{
 			ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
-			EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
+			EXPECT_NEAR(s->factor, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
 		}
 		else
 		{
@@ -223,7 +223,7 @@ TEST(MetricScale, FallsBackOnEveryPointWhenTheWellTriangulatedOnesGiveNoEstimate
 	slam::MetricScale scale(options());
 	const auto s = scale.update(map);
 	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
-	EXPECT_NEAR(*s, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
+	EXPECT_NEAR(s->factor, kCameraHeight / kHeightMap, 1e-6 * kCameraHeight / kHeightMap);
 }
 
 TEST(MetricScale, NeedsACameraHeightAndValidOptions)
@@ -274,55 +274,152 @@ TEST(MetricScale, TheMapsFloorLiesUnderALevelCameraPathAndComesFromThePointsOthe
 	}
 }
 
-// A long run whose scale drifted: along a straight path the keyframes and floor of the first
-// 30 keyframes are metric (cameras camera_height above the floor), those of the newest 20 came
-// out 20 % small. Over the whole map the old stretch outvotes the new one and the estimate
-// keeps the scale (factor 1); along the newest window_path_length of the path it is the scale
-// where the camera is, camera_height / (0.8 camera_height) = 1.25, and it rescales the whole map.
-TEST(MetricScale, AfterTheFirstEstimateTheFloorIsSearchedAlongTheNewestStretchOfThePath)
+// A long run whose scale drifted: along a straight, level path the keyframes and floor of the
+// first 30 keyframes are metric (cameras camera_height above the floor, 0.5 m apart), those of
+// the newest 20 came out 20 % small (steps of 0.4 map units, the floor 0.8 camera_height under
+// the same level path). Over the whole map the floor is the metric one, under both stretches'
+// points, and the estimate keeps the scale (factor 1). Along the newest window_path_length of
+// path it is the scale where the camera is, camera_height / (0.8 camera_height) = 1.25: the
+// window alone is rescaled (its oldest keyframe and the map before it stay, the newest keyframe's
+// content grows by 1.25 about it), or the whole map with rescale_whole_map; a window_max_change
+// below 0.25 refuses the estimate and leaves the map as it was.
+TEST(MetricScale, AfterTheFirstEstimateTheNewestStretchOfThePathIsMeasuredAndRescaled)
 {
 	constexpr double kDrift = 0.8;
 	constexpr int kMetric = 30, kDrifted = 20;
-	const auto straight = [](double x, double h) { return camera(x, 0, h, 0); };
-	for (const double window : {8.0, 0.0})
+	struct Case
 	{
-		SCOPED_TRACE(window);
+		double window;
+		bool wholeMapOption;
+		double maxChange;
+	};
+	for (const auto& [window, wholeMapOption, maxChange] : {Case{4.2, false, 0.3}, Case{4.2, true, 0.3}, Case{4.2, false, 0.2}, Case{0.0, false, 0.3}})
+	{
+		SCOPED_TRACE(std::to_string(window) + " " + std::to_string(maxChange) + (wholeMapOption ? " whole map" : ""));
+		const bool refused = maxChange < 1 / kDrift - 1;
 		sfm::SparseMap map;
 		auto o = options();
 		o.windowPathLength = window;
+		o.rescaleWholeMap = wholeMapOption;
+		o.windowMaxChange = maxChange;
 		o.reestimateEvery = 1;
 		slam::MetricScale scale(o);
 		// Floor points ahead of every other keyframe, seen from it and the next one.
 		std::mt19937 rng(3);
 		std::vector<sfm::KeyFrameId> ids;
-		const auto addStretch = [&](int from, int to, double height)
+		std::vector<sfm::LandmarkId> newestFloor;
+		double x = 0;
+		const auto addStretch = [&](int from, int to, double unit)
 		{
-			for (int k = from; k < to; k++) ids.push_back(map.addKeyFrame(keyFrame(straight(0.5 * k, height), 400)).id);
+			for (int k = from; k < to; k++, x += 0.5 * unit) ids.push_back(map.addKeyFrame(keyFrame(camera(x, 0, kCameraHeight, 0), 400)).id);
 			for (int k = from; k + 1 < to; k += 2)
 			{
-				std::uniform_real_distribution<double> ux(0.5 * k + 1.0, 0.5 * k + 4.0), uy(-2, 2);
-				for (int i = 0; i < 400; i++) map.addObservation(map.addLandmark({ux(rng), uy(rng), 0.0}, ids[k], i), ids[k + 1], i);
+				const double xk = map.keyframe(ids[k]).T_world_cam.x();
+				std::uniform_real_distribution<double> ux(xk + 1.0 * unit, xk + 4.0 * unit), uy(-2 * unit, 2 * unit);
+				for (int i = 0; i < 400; i++)
+				{
+					const auto l = map.addLandmark({ux(rng), uy(rng), kCameraHeight * (1 - unit)}, ids[k + 1], i);
+					map.addObservation(l, ids[k], i);
+					if (k + 2 == to) newestFloor.push_back(l);
+				}
 			}
 		};
-		addStretch(0, kMetric, kCameraHeight);
+		addStretch(0, kMetric, 1.0);
 		const auto first = scale.update(map);
 		ASSERT_TRUE(first.has_value()) << scale.stats().lastMessage;
-		EXPECT_NEAR(*first, 1.0, 1e-6);
-		addStretch(kMetric, kMetric + kDrifted, kDrift * kCameraHeight);
+		EXPECT_NEAR(first->factor, 1.0, 1e-6);
+		EXPECT_TRUE(first->wholeMap());
+		addStretch(kMetric, kMetric + kDrifted, kDrift);
+		std::map<sfm::KeyFrameId, CPose3D> before;
+		for (const auto& [id, kf] : map.keyframes()) before[id] = kf.T_world_cam;
 		const auto s = scale.update(map);
-		ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
 		ASSERT_EQ(scale.log().size(), 2u);
-		if (window > 0)
+		if (refused)
 		{
-			EXPECT_NEAR(*s, 1.0 / kDrift, 1e-6);
-			EXPECT_NEAR(map.keyframe(ids.back()).T_world_cam.z(), kCameraHeight, 1e-6);
-			// 8 m of path at 0.5 m between keyframes: the newest 17.
-			EXPECT_NE(scale.log()[1].find("keyframe 49, 17 keyframes"), std::string::npos) << scale.log()[1];
+			EXPECT_FALSE(s.has_value());
+			EXPECT_NE(scale.log()[1].find("exceeds window_max_change"), std::string::npos) << scale.log()[1];
+			for (const auto& [id, T] : before) EXPECT_EQ(map.keyframe(id).T_world_cam.asVectorVal(), T.asVectorVal()) << id;
+			continue;
+		}
+		ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+		if (window == 0)
+		{
+			EXPECT_NEAR(s->factor, 1.0, 1e-6);
+			EXPECT_NE(scale.log()[1].find("keyframe 49, 50 keyframes"), std::string::npos) << scale.log()[1];
+			continue;
+		}
+		EXPECT_NEAR(s->factor, 1.0 / kDrift, 1e-6);
+		// 4.2 map units of path at 0.4 between keyframes: the newest 11.
+		EXPECT_NE(scale.log()[1].find("keyframe 49, 11 keyframes"), std::string::npos) << scale.log()[1];
+		if (wholeMapOption)
+		{
+			EXPECT_TRUE(s->wholeMap());
+			EXPECT_NEAR(map.keyframe(ids.front()).T_world_cam.z(), kCameraHeight / kDrift, 1e-6);
+			continue;
+		}
+		ASSERT_FALSE(s->wholeMap());
+		ASSERT_EQ(s->newScales.size(), 11u);
+		EXPECT_EQ(s->newScales.begin()->first, ids[kMetric + kDrifted - 11]);
+		EXPECT_NEAR(s->newScales.begin()->second, 1.0, 1e-12);
+		EXPECT_NEAR(s->newScales.rbegin()->second, 1.0 / kDrift, 1e-12);
+		// The map before the window and the window's oldest keyframe stay; the path stays level.
+		for (const auto& [id, T] : before)
+		{
+			const auto& now = map.keyframe(id).T_world_cam;
+			if (id <= ids[kMetric + kDrifted - 11]) EXPECT_NEAR((now.asVectorVal() - T.asVectorVal()).norm(), 0.0, 1e-12) << id;
+			EXPECT_NEAR(now.z(), kCameraHeight, 1e-9) << id;
+		}
+		// From the window's middle on, steps and floor are metric: the newest keyframe's floor
+		// points lie on the true floor.
+		EXPECT_NEAR(map.keyframe(ids.back()).T_world_cam.x() - map.keyframe(ids[ids.size() - 2]).T_world_cam.x(), 0.5, 1e-9);
+		for (const auto l : newestFloor) ASSERT_NEAR(map.landmark(l).p_world.z(), 0.0, 1e-9);
+	}
+}
+
+// Along the newest stretch a monocular map keeps stray points under its floor. Here 4 % of the
+// window's points lie 0.2-1 m under it: the stricter max_below_share refuses the floor ("points
+// under every large plane"), window_max_below_share = 3 takes it, and the scale stays exact.
+TEST(MetricScale, TheWindowSearchTakesAFloorWithStrayPointsUnderIt)
+{
+	for (const double share : {3.0, 0.5})
+	{
+		SCOPED_TRACE(share);
+		sfm::SparseMap map;
+		auto o = options();
+		o.windowPathLength = 4.2;
+		o.reestimateEvery = 1;
+		o.windowMaxBelowShare = share;
+		slam::MetricScale scale(o);
+		std::mt19937 rng(4);
+		std::vector<sfm::KeyFrameId> ids;
+		const auto addStretch = [&](int from, int to, double strayShare)
+		{
+			for (int k = from; k < to; k++) ids.push_back(map.addKeyFrame(keyFrame(camera(0.5 * k, 0, kCameraHeight, 0), 400)).id);
+			std::uniform_real_distribution<double> U(0, 1);
+			for (int k = from; k + 1 < to; k += 2)
+			{
+				const double xk = 0.5 * k;
+				for (int i = 0; i < 400; i++)
+				{
+					const double z = U(rng) < strayShare ? -0.2 - 0.8 * U(rng) : 0.0;
+					map.addObservation(map.addLandmark({xk + 1.0 + 3.0 * U(rng), -2.0 + 4.0 * U(rng), z}, ids[k + 1], i), ids[k], i);
+				}
+			}
+		};
+		addStretch(0, 30, 0.0);
+		ASSERT_TRUE(scale.update(map).has_value()) << scale.stats().lastMessage;
+		addStretch(30, 50, 0.04);
+		const auto s = scale.update(map);
+		if (share > 1)
+		{
+			ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+			EXPECT_FALSE(s->wholeMap());
+			EXPECT_NEAR(s->factor, 1.0, 1e-6);
 		}
 		else
 		{
-			EXPECT_NEAR(*s, 1.0, 1e-6);
-			EXPECT_NE(scale.log()[1].find("keyframe 49, 50 keyframes"), std::string::npos) << scale.log()[1];
+			EXPECT_FALSE(s.has_value());
+			EXPECT_NE(scale.stats().lastMessage.find("the lowest large plane has"), std::string::npos) << scale.stats().lastMessage;
 		}
 	}
 }

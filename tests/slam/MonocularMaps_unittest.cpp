@@ -116,9 +116,9 @@ TEST(MonocularMaps, GridIsRebuiltInMetresOnTheCameraHeightFloor)
 	slam::MetricScale scale(scaleOptions());
 	const auto s = scale.update(map);
 	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
-	ASSERT_NEAR(*s, kCameraHeight / kHeightMap, 1e-5);
+	ASSERT_NEAR(s->factor, kCameraHeight / kHeightMap, 1e-5);
 	const auto& plane = *scale.floorPlane();
-	maps->applyRescale(map, *s, plane.normal, plane.offset);
+	maps->applyRescale(map, s->factor, plane.normal, plane.offset);
 
 	// The floor frame: z up on the true floor (world z = 0), in metres.
 	ASSERT_TRUE(maps->T_world_floor().has_value());
@@ -129,7 +129,7 @@ TEST(MonocularMaps, GridIsRebuiltInMetresOnTheCameraHeightFloor)
 	// Every occupied cell lies on a wall (at 2 map units = 5.2 m from the centre, within a
 	// cell and a half), and the walls are found along their whole length.
 	const auto& g = grid(*maps);
-	const double wallM = kWall * *s, tol = 1.5 * g.resolution();
+	const double wallM = kWall * s->factor, tol = 1.5 * g.resolution();
 	std::size_t occupied = 0, offWall = 0;
 	for (int cx = 0; cx < g.sizeX(); cx++)
 		for (int cy = 0; cy < g.sizeY(); cy++)

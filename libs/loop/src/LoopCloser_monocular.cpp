@@ -6,6 +6,7 @@
 
 #include <keygrid/loop/DirectIndexMatcher.h>
 #include <keygrid/loop/LoopCloser.h>
+#include <keygrid/loop/Sim3MapCorrection.h>
 #include <keygrid/sfm/Matcher.h>
 
 #include <set>
@@ -26,15 +27,6 @@ constexpr std::size_t kProjectionGroupNeighbours = 10;
 constexpr float kProjectionRadiusPx = 10.0f;
 
 using KeyFrameSims = std::map<sfm::KeyFrameId, Sim3>;
-
-/** Every keyframe's pose as a similarity of unit scale: the map's units are the same
- * everywhere before the correction. */
-KeyFrameSims keyFrameSims(const sfm::SparseMap& map)
-{
-	KeyFrameSims out;
-	for (const auto& [id, kf] : map.keyframes()) out[id] = Sim3::fromIsometry(toIsometry(kf.T_world_cam));
-	return out;
-}
 
 /** The matched keypoints of keyframes a and b that both carry a landmark, as Sim3 matches:
  * each landmark in its keyframe's camera frame. */
@@ -77,7 +69,9 @@ bool LoopCloser::verifySim3(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm
 	if (!a.features.isBinary()) mo.maxDistance = m_matcher.maxDistanceSift;
 	const auto matches = landmarkMatches(m_map, a, b, matchByDirectIndex(a.features.descriptors, fa, b.features.descriptors, fb, mo));
 	rec.matches = static_cast<int>(matches.size());
-	const auto r = detail::verifiedByRansac(rec, m_opts.sim3.minInliers, [&] { return estimateSim3Ransac(matches, K, m_opts.sim3); });
+	Sim3RansacOptions ransac = m_opts.sim3;
+	ransac.fixScale = m_metricUnits;
+	const auto r = detail::verifiedByRansac(rec, ransac.minInliers, [&] { return estimateSim3Ransac(matches, K, ransac); });
 	if (!r) return false;
 	// A few matches can agree by chance; a true loop puts the whole place right: the loop
 	// side's landmarks must land on the current keyframe's keypoints.
@@ -128,12 +122,14 @@ LoopClosureEvent LoopCloser::correctSim3(sfm::KeyFrameId cur, sfm::KeyFrameId ca
 	// edge the verified similarity. The first keyframe is fixed, scale included: the corrected
 	// map keeps its units (those of the map start, or the metres of slam::MetricScale), and the
 	// scale drift is spread over the keyframes of the loop. A merge first moves the current
-	// map by the similarity that makes the loop measurement hold.
+	// map by the similarity that makes the loop measurement hold. In a metric map (setMetricUnits)
+	// the loop's similarity has unit scale and every keyframe keeps its scale.
 	const std::uint32_t curMap = m_map.keyframe(cur).mapId, loopMap = m_map.keyframe(cand).mapId;
 	const bool merge = curMap != loopMap;
 	const KeyFrameSims oldS = keyFrameSims(m_map);
 	const Sim3 align = merge ? oldS.at(cand) * S_cand_cur * oldS.at(cur).inverse() : Sim3{};
 	Sim3PoseGraph g = detail::loopCorrectionGraph<Sim3PoseGraph>(m_map, oldS, cur, cand, S_cand_cur, align, m_opts.covisibilityEdgeMinWeight);
+	g.setScalesFixed(m_metricUnits);
 	PoseGraphOptions o = m_opts.poseGraph;
 	o.loopLossScale = Sim3PoseGraph::defaultOptions().loopLossScale;  // 7 DOF instead of 6
 	const auto summary = g.optimize(o);
@@ -149,12 +145,11 @@ LoopClosureEvent LoopCloser::correctSim3(sfm::KeyFrameId cur, sfm::KeyFrameId ca
 	{
 		newS[c.id] = c.S_world_kf_new;
 		if (merge && m_map.keyframe(c.id).mapId == curMap) m_map.keyframe(c.id).mapId = loopMap;
-		// The camera's centre and orientation; its scale goes into its landmarks below.
-		m_map.keyframe(c.id).T_world_cam = toCPose3D(c.S_world_kf_new.rigid());
-		ev.newPoses[c.id] = m_map.keyframe(c.id).T_world_cam;
 		ev.newScales[c.id] = c.S_world_kf_new.s / oldS.at(c.id).s;
 	}
-	detail::moveLandmarksWithKeyFrames(m_map, oldS, newS);
+	// The cameras' centres and orientations; their scales go into their landmarks.
+	applySim3Corrections(m_map, oldS, newS);
+	for (const auto& [id, S] : newS) ev.newPoses[id] = m_map.keyframe(id).T_world_cam;
 	ev.correctionMetres = (newS.at(cur).t - oldS.at(cur).t).norm();
 	ev.scaleCorrection = newS.at(cur).s / oldS.at(cur).s;
 	detail::joinLoopSides(m_map, m_mapper, cur, cand, K);

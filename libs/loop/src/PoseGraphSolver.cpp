@@ -47,6 +47,12 @@ void GraphProblem::addResidual(ceres::CostFunction* cost, EdgeKind kind, const s
 	m_problem.AddResidualBlock(cost, kind == EdgeKind::Loop ? m_loopLoss.get() : nullptr, blocks);
 }
 
+void GraphProblem::holdScalesConstant()
+{
+	for (auto& [id, v] : m_vertices)
+		if (m_problem.HasParameterBlock(&v.logScale)) m_problem.SetParameterBlockConstant(&v.logScale);
+}
+
 PoseGraphSolverReport GraphProblem::solve(const std::vector<KeyFrameId>& fixed)
 {
 	for (auto& [id, v] : m_vertices)

@@ -95,6 +95,8 @@ class GraphProblem
 	VertexBlocks& vertex(KeyFrameId id) { return m_vertices.at(id); }
 	/** The residual of an edge of the given kind over blocks of its two vertices. */
 	void addResidual(ceres::CostFunction* cost, EdgeKind kind, const std::vector<double*>& blocks);
+	/** Holds every vertex's scale block constant (Sim(3) graphs of a metric map). */
+	void holdScalesConstant();
 
 	/** Holds every block of the fixed vertices constant and solves with SPARSE_NORMAL_CHOLESKY
 	 * (SuiteSparse, Eigen's sparse Cholesky if Ceres lacks it) within the options' limits. A

@@ -75,6 +75,7 @@ Sim3PoseGraphSummary Sim3PoseGraph::optimize(const PoseGraphOptions& opts)
 		ceres::CostFunction* cost = RelativeSim3Error::Create(e.S_a_b, detail::sqrtInformation(e.information));
 		problem.addResidual(cost, e.kind, {a.t, a.q, &a.logScale, b.t, b.q, &b.logScale});
 	}
+	if (m_scalesFixed) problem.holdScalesConstant();
 
 	// Gauge freedom: every residual depends only on relative similarities S_world_a^-1 S_world_b,
 	// so the cost is unchanged if all vertices are moved by the same similarity G (S -> G S):

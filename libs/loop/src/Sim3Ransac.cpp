@@ -80,10 +80,10 @@ int classify(const std::vector<Sim3Match>& ms, const Sim3& S, const core::Pinhol
 	return n;
 }
 
-/** Umeyama fit with scale of p_a ~= s R p_b + t on three pairs; false when they are (near)
- * collinear on either side, as then no rotation is fixed. The test is relative (triangle area
- * against its squared edges): the map's units are arbitrary. */
-bool fitMinimal(const std::vector<Sim3Match>& ms, const std::size_t s[3], Sim3& S)
+/** Umeyama fit of p_a ~= s R p_b + t on three pairs (s = 1 when fixScale); false when they are
+ * (near) collinear on either side, as then no rotation is fixed. The test is relative (triangle
+ * area against its squared edges): the map's units are arbitrary. */
+bool fitMinimal(const std::vector<Sim3Match>& ms, const std::size_t s[3], bool fixScale, Sim3& S)
 {
 	Eigen::Matrix3d src, dst;
 	for (int i = 0; i < 3; ++i)
@@ -97,16 +97,17 @@ bool fitMinimal(const std::vector<Sim3Match>& ms, const std::size_t s[3], Sim3& 
 		const double edges = e1.squaredNorm() + e2.squaredNorm() + (e2 - e1).squaredNorm();
 		if (!(e1.cross(e2).norm() > 1e-3 * edges)) return false;
 	}
-	const Eigen::Matrix4d T = Eigen::umeyama(src, dst, true);
+	const Eigen::Matrix4d T = Eigen::umeyama(src, dst, !fixScale);
 	if (!T.allFinite()) return false;
 	const double scale = T.topLeftCorner<3, 3>().col(0).norm();
 	if (!(scale > 0)) return false;
-	S = Sim3{Eigen::Quaterniond(Eigen::Matrix3d(T.topLeftCorner<3, 3>() / scale)).normalized(), T.topRightCorner<3, 1>(), scale};
+	S = Sim3{Eigen::Quaterniond(Eigen::Matrix3d(T.topLeftCorner<3, 3>() / scale)).normalized(), T.topRightCorner<3, 1>(), fixScale ? 1.0 : scale};
 	return true;
 }
 
-/** Minimises the matches' reprojection errors over S (Huber loss at the inlier threshold). */
-Sim3 refine(const std::vector<Sim3Match>& ms, const std::vector<char>& inlier, const Sim3& S0, const core::PinholeIntrinsics& K, double chi2)
+/** Minimises the matches' reprojection errors over S (Huber loss at the inlier threshold); the
+ * scale stays that of S0 when fixScale. */
+Sim3 refine(const std::vector<Sim3Match>& ms, const std::vector<char>& inlier, const Sim3& S0, const core::PinholeIntrinsics& K, double chi2, bool fixScale)
 {
 	Eigen::Quaterniond q = S0.q;
 	Eigen::Vector3d t = S0.t;
@@ -115,7 +116,9 @@ Sim3 refine(const std::vector<Sim3Match>& ms, const std::vector<char>& inlier, c
 	for (std::size_t i = 0; i < ms.size(); ++i)
 		if (inlier[i])
 			problem.AddResidualBlock(Sim3ReprojectionError::Create(ms[i], K), new ceres::HuberLoss(std::sqrt(chi2)), q.coeffs().data(), t.data(), &logS);
+	if (problem.NumResidualBlocks() == 0) return S0;
 	problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold());
+	if (fixScale) problem.SetParameterBlockConstant(&logS);
 	ceres::Solver::Options o;
 	o.linear_solver_type = ceres::DENSE_QR;
 	o.max_num_iterations = 10;
@@ -152,7 +155,7 @@ Sim3RansacResult estimateSim3Ransac(const std::vector<Sim3Match>& ms, const core
 		[&](const std::size_t s[3]) -> std::optional<int>
 		{
 			Sim3 S;
-			if (!fitMinimal(ms, s, S)) return std::nullopt;
+			if (!fitMinimal(ms, s, opts.fixScale, S)) return std::nullopt;
 			const int count = classify(ms, S, K, opts.inlierChi2, inl);
 			if (count <= bestCount) return std::nullopt;
 			bestCount = count;
@@ -165,7 +168,7 @@ Sim3RansacResult estimateSim3Ransac(const std::vector<Sim3Match>& ms, const core
 	int count = classify(ms, best, K, opts.inlierChi2, inl);
 	for (int r = 0; r < opts.refinementRounds && count >= 3; ++r)
 	{
-		best = refine(ms, inl, best, K, opts.inlierChi2);
+		best = refine(ms, inl, best, K, opts.inlierChi2, opts.fixScale);
 		count = classify(ms, best, K, opts.inlierChi2, inl);
 	}
 	res.S_a_b = best;

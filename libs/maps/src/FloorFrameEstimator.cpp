@@ -10,6 +10,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <limits>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -423,6 +424,33 @@ std::optional<FloorPlaneFit> estimateLowestFloorPlane(
 		best = fit;
 		up = r.normal;
 		tiltDeg = o.refineTiltDeg;
+	}
+	// A generous maxBelowShare lets the points under a plane be as many as the least support:
+	// when they form a large plane of their own (the floor under a desk top), that lower plane
+	// is the floor; points scattered under the floor (a monocular map's stray ones) form none.
+	if (best && best->below >= minSupport)
+	{
+		std::vector<TPoint3D> under;
+		std::vector<double> underWeights;
+		for (std::size_t i = 0; i < n; i++)
+			if (best->plane.height(pts[i]) < -o.belowDistance)
+			{
+				under.push_back(pts[i]);
+				if (!weights.empty()) underWeights.push_back(weights[i]);
+			}
+		FloorFrameOptions lower = o;
+		lower.minSupport = std::numeric_limits<double>::min();  // the absolute count below rules
+		lower.minSupportPoints = static_cast<int>(minSupport);
+		lower.parallelPlanes = false;
+		lower.lowestFraction = 1.0;  // the few points under it: stray ones may be the lowest
+		if (const auto f = estimateLowestFloorPlane(under, best->plane.normal, cams, lower, underWeights))
+		{
+			const Counts k = count(pts, f->plane, o.inlierDistance, o.belowDistance);
+			best->plane = f->plane;
+			best->plane.inliers = k.inliers;
+			best->below = k.below;
+			best->clearBelow = static_cast<double>(k.below) <= maxBelow;
+		}
 	}
 	if (best && o.parallelPlanes)
 	{

@@ -21,6 +21,7 @@ core::OptionFields CameraHeightScaleOptions::fields()
 	f.add("min_depression_deg", minDepressionDeg, "a point this far under its nearest camera's horizontal is below [deg]", R::fromBelow(0, 90));
 	f.add("inlier_distance", inlierDistance, "point-to-plane distance of a floor inlier [m, map at the estimated scale]", R::positive());
 	f.add("below_distance", belowDistance, "a point this far under a plane is below it [m, map at the estimated scale]", R::positive());
+	f.add("max_below_share", maxBelowShare, "more points below a plane than this x the least floor support: not the floor", R::atLeast(0));
 	f.add("max_tilt_deg", maxTiltDeg, "largest angle floor normal / cameras' mean -y [deg]", R::between(0, 90));
 	f.add("hypotheses", hypotheses, "RANSAC plane hypotheses per search round", R::atLeast(1));
 	f.add("min_floor_share", minFloorShare, "least floor support: share of the points below ...", R::aboveUpTo(0, 1));
@@ -177,6 +178,7 @@ CameraHeightScaleResult CameraHeightScaleEstimator::estimate(
 	maps::FloorFrameOptions search;
 	search.inlierDistance = o.inlierDistance;
 	search.belowDistance = o.belowDistance;
+	search.maxBelowShare = o.maxBelowShare;
 	search.maxTiltDeg = o.maxTiltDeg;
 	search.hypotheses = o.hypotheses;
 	search.minSupport = o.minFloorShare;

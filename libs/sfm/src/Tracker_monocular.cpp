@@ -247,6 +247,13 @@ void Tracker::onMapRescaled(double s)
 	if (m_lastRelative) scaleTranslation(m_lastRelative->second, s);
 }
 
+void Tracker::onMapRescaledLocally(double s)
+{
+	if (m_velocity) scaleTranslation(*m_velocity, s);
+	if (m_lastRelative) scaleTranslation(m_lastRelative->second, s);
+	onMapCorrected();
+}
+
 bool Tracker::needKeyFrameMonocular(const Current& cur) const
 {
 	const auto& mo = m_opts.mono;

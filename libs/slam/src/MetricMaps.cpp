@@ -293,17 +293,20 @@ std::map<std::string, double> MetricMaps::applyRescale(
 		T_old = T_new;
 	}
 	for (auto& [id, t] : m_travelled) t *= s;
-	if (m_floorFromHeight && !m_insertedPoses.empty())
-	{
-		// The frame's origin and heading: the first keyframe's footprint and view direction.
-		const auto& first = m_insertedPoses.begin()->second;
-		maps::FloorPlane plane;
-		plane.normal = mrpt::math::TVector3D(n_floor.x(), n_floor.y(), n_floor.z());
-		plane.d = d_floor;
-		m_heightFloor = maps::floorPoseFromPlane(plane, first.translation(), first.rotateVector(mrpt::math::TVector3D(0, 0, 1)));
-	}
+	setFloorFromCameraHeight(n_floor, d_floor);
 	correction.T_world_floor = T_world_floor();
 	return dispatchCorrection(correction);
+}
+
+void MetricMaps::setFloorFromCameraHeight(const Eigen::Vector3d& n_floor, double d_floor)
+{
+	if (!m_floorFromHeight || m_insertedPoses.empty()) return;
+	// The frame's origin and heading: the first keyframe's footprint and view direction.
+	const auto& first = m_insertedPoses.begin()->second;
+	maps::FloorPlane plane;
+	plane.normal = mrpt::math::TVector3D(n_floor.x(), n_floor.y(), n_floor.z());
+	plane.d = d_floor;
+	m_heightFloor = maps::floorPoseFromPlane(plane, first.translation(), first.rotateVector(mrpt::math::TVector3D(0, 0, 1)));
 }
 
 std::string MetricMaps::floorJson() const

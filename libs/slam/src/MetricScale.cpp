@@ -1,3 +1,4 @@
+#include <keygrid/loop/Sim3MapCorrection.h>
 #include <keygrid/slam/MetricScale.h>
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -16,9 +17,12 @@ core::OptionFields MetricScaleOptions::fields()
 {
 	core::OptionFields f = estimator.fields();
 	f.add("min_point_parallax_deg", minPointParallaxDeg, "map points seen under rays less far apart are left out of the floor search [deg]; 0 = all", core::OptionRule::fromBelow(0, 90));
+	f.add("window_max_below_share", windowMaxBelowShare, "the floor search along the newest stretch takes a plane with up to this x its least support of points under it", core::OptionRule::atLeast(0));
 	f.add("window_path_length", windowPathLength, "once metric, the floor is searched along this much of the newest path [m]; 0 = whole map", core::OptionRule::atLeast(0));
 	f.add("path_floor_max_rms", pathFloorMaxRms, "the maps' floor is the plane through the keyframe centres, camera_height under it, when they lie this close to one plane [m]; 0 = the floor points' plane", core::OptionRule::atLeast(0));
 	f.add("path_floor_min_spread", pathFloorMinSpread, "... and when the path spreads this far across its main direction [m]", core::OptionRule::atLeast(0));
+	f.add("rescale_whole_map", rescaleWholeMap, "every estimate rescales the whole map, not only the newest window_path_length of path");
+	f.add("window_max_change", windowMaxChange, "an estimate along the newest stretch changing the scale by more than this share is refused; 0 = no bound", core::OptionRule::atLeast(0));
 	f.add("reestimate_every", reestimateEvery, "after the first estimate, estimate and rescale again every this many keyframes", core::OptionRule::positive());
 	return f;
 }
@@ -100,11 +104,63 @@ std::optional<MetricScale::FloorPlane> floorUnderThePath(
 	why = "floor under the " + why;
 	return MetricScale::FloorPlane{n, o.estimator.cameraHeight - n.dot(mean)};
 }
+
+/** Rescales the window's keyframes (ascending ids, the newest stretch of path) and their
+ * landmarks by a ramp: keyframe i of the N takes the scale f^min(1, i / (N / 2)), 1 at the
+ * oldest (joined to the map before it) and the estimate's f from the middle keyframe on, whose
+ * height the estimate measured (a median over the window). The path is re-chained in id order,
+ * each step scaled by the geometric mean of its ends' scales; orientations stay. */
+MetricScale::Rescale rescaleWindow(sfm::SparseMap& map, const std::vector<sfm::KeyFrameId>& window, double f)
+{
+	const auto oldS = loop::keyFrameSims(map);
+	std::map<sfm::KeyFrameId, loop::Sim3> newS;
+	const double half = std::max(1.0, 0.5 * static_cast<double>(window.size() - 1));
+	MetricScale::Rescale out;
+	out.factor = f;
+	Eigen::Vector3d prevOld = oldS.at(window.front()).t, prevNew = prevOld;
+	double prevScale = 1.0;
+	for (std::size_t i = 0; i < window.size(); i++)
+	{
+		const loop::Sim3& S = oldS.at(window[i]);
+		const double s = std::pow(f, std::min(1.0, static_cast<double>(i) / half));
+		const Eigen::Vector3d c = prevNew + std::sqrt(s * prevScale) * (S.t - prevOld);
+		newS[window[i]] = loop::Sim3{S.q, c, s};
+		out.newScales[window[i]] = s;
+		prevOld = S.t;
+		prevNew = c;
+		prevScale = s;
+	}
+	loop::applySim3Corrections(map, oldS, newS);
+	for (const sfm::KeyFrameId id : window) out.newPoses[id] = map.keyframe(id).T_world_cam;
+	return out;
+}
+
+/** The window's median keyframe height along n above the origin plane n . p = 0. */
+double medianHeight(const sfm::SparseMap& map, const std::vector<sfm::KeyFrameId>& window, const Eigen::Vector3d& n)
+{
+	std::vector<double> h;
+	for (const sfm::KeyFrameId id : window) h.push_back(n.dot(sfm::translationOf(map.keyframe(id).T_world_cam)));
+	std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
+	return h[h.size() / 2];
+}
 }  // namespace
 
-MetricScale::MetricScale(const MetricScaleOptions& opts) : m_opts(opts), m_estimator(opts.estimator) { opts.validate(); }
+namespace
+{
+sfm::CameraHeightScaleOptions withMaxBelowShare(sfm::CameraHeightScaleOptions o, double share)
+{
+	o.maxBelowShare = share;
+	return o;
+}
+}  // namespace
 
-std::optional<double> MetricScale::update(sfm::SparseMap& map)
+MetricScale::MetricScale(const MetricScaleOptions& opts)
+	: m_opts(opts), m_estimator(opts.estimator), m_windowEstimator(withMaxBelowShare(opts.estimator, opts.windowMaxBelowShare))
+{
+	opts.validate();
+}
+
+std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 {
 	if (map.keyframes().empty()) return std::nullopt;
 	const sfm::KeyFrameId newest = map.keyframes().rbegin()->first;
@@ -127,27 +183,48 @@ std::optional<double> MetricScale::update(sfm::SparseMap& map)
 		all.push_back(lm.p_world);
 		if (!(sfm::largestParallaxCos(map, lm) > minCos)) points.push_back(lm.p_world);
 	}
-	auto r = m_estimator.estimate(poses, points);
-	if (!r.ok && points.size() < all.size()) r = m_estimator.estimate(poses, all);
+	const auto& estimator = wholeMap ? m_estimator : m_windowEstimator;
+	auto r = estimator.estimate(poses, points);
+	if (!r.ok && points.size() < all.size()) r = estimator.estimate(poses, all);
+	if (r.ok && !wholeMap && m_opts.windowMaxChange > 0 && std::abs(r.scale - 1) > m_opts.windowMaxChange)
+	{
+		r.ok = false;
+		r.message = "refused: a change of x" + std::to_string(r.scale) + " along the newest stretch exceeds window_max_change = " +
+					std::to_string(m_opts.windowMaxChange) + " (a plane above the floor?); " + r.message;
+	}
 	m_stats.estimates++;
 	m_stats.lastMessage = r.message;
 	std::string floorSource;
+	Rescale applied;
 	if (r.ok)
 	{
-		map.rescale(r.scale);
-		// The plane was found in the map before the rescale: its offset scales with the map.
-		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource)
-						   .value_or(FloorPlane{r.floorNormal, r.floorOffset * r.scale});
+		// The whole map while the window is all of it or when asked for; else the window alone.
+		std::optional<FloorPlane> found;
+		if (wholeMap || m_opts.rescaleWholeMap || window.size() < 2)
+		{
+			map.rescale(r.scale);
+			applied.factor = r.scale;
+			// The plane was found in the map before the rescale: its offset scales with the map.
+			found = FloorPlane{r.floorNormal, r.floorOffset * r.scale};
+		}
+		else
+		{
+			applied = rescaleWindow(map, window, r.scale);
+			// The floor the estimate found, camera_height under the rescaled window.
+			found = FloorPlane{r.floorNormal, m_opts.estimator.cameraHeight - medianHeight(map, window, r.floorNormal)};
+		}
+		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource).value_or(*found);
 	}
 	if (m_log.size() < kMaxLogLines)
 		m_log.push_back(
 			"keyframe " + std::to_string(newest) + ", " + std::to_string(window.size()) + " keyframes, " + std::to_string(all.size()) +
-			" points: " + (r.ok ? "x" + std::to_string(r.scale) + ", " : "") + r.message + (r.ok ? "; " + floorSource : ""));
+			" points: " + (r.ok ? "x" + std::to_string(r.scale) + (applied.wholeMap() ? " (whole map), " : " (window), ") : "") +
+			r.message + (r.ok ? "; " + floorSource : ""));
 	if (!r.ok) return std::nullopt;
 	m_stats.applied++;
 	m_stats.totalFactor *= r.scale;
 	m_stats.lastFactor = r.scale;
-	return r.scale;
+	return applied;
 }
 
 }  // namespace keygrid::slam

@@ -243,30 +243,69 @@ void System::logInitialization(const sfm::TrackedFrame& tf)
 void System::applyMetricScale(sfm::TrackedFrame* tf)
 {
 	const auto t0 = std::chrono::steady_clock::now();
-	const auto s = m_metricScale->update(m_map);
+	const auto r = m_metricScale->update(m_map);
 	m_timings.add("metric_scale", secondsSince(t0));
-	if (!s) return;
+	if (!r) return;
+	// Loops now keep the map's metres (LoopCloser::setMetricUnits).
+	if (m_loopCloser) m_loopCloser->setMetricUnits(true);
 	// A bundle adjustment solved meanwhile (threaded mode) was solved at the old scale.
 	m_map.noteCorrection();
 	m_correctionsSeen = m_map.corrections();
-	m_tracker.onMapRescaled(*s);
+	if (r->wholeMap())
+		followWholeMapRescale(r->factor, tf);
+	else
+		followWindowRescale(*r, tf);
+}
+
+void System::followWholeMapRescale(double s, sfm::TrackedFrame* tf)
+{
+	m_tracker.onMapRescaled(s);
 	if (tf)
 	{
-		sfm::scaleTranslation(tf->T_world_cam, *s);
-		sfm::scaleTranslation(tf->T_ref_cam, *s);
+		sfm::scaleTranslation(tf->T_world_cam, s);
+		sfm::scaleTranslation(tf->T_ref_cam, s);
 	}
 	for (auto& f : m_frames)
 	{
-		sfm::scaleTranslation(f.T_world_cam, *s);
-		sfm::scaleTranslation(f.T_ref_cam, *s);
+		sfm::scaleTranslation(f.T_world_cam, s);
+		sfm::scaleTranslation(f.T_ref_cam, s);
 	}
-	m_travelled *= *s;
-	if (m_lastTrackedPose) sfm::scaleTranslation(*m_lastTrackedPose, *s);
+	m_travelled *= s;
+	if (m_lastTrackedPose) sfm::scaleTranslation(*m_lastTrackedPose, s);
 	// The maps follow: what they hold is rebuilt in the new scale, on the estimate's floor.
 	if (m_maps && m_metricScale->floorPlane())
 	{
 		const auto& floor = *m_metricScale->floorPlane();
-		for (const auto& [name, sec] : m_maps->applyRescale(m_map, *s, floor.normal, floor.offset))
+		for (const auto& [name, sec] : m_maps->applyRescale(m_map, s, floor.normal, floor.offset))
+			m_timings.add("map_correction:" + name, sec);
+	}
+}
+
+void System::followWindowRescale(const MetricScale::Rescale& r, sfm::TrackedFrame* tf)
+{
+	// A frame keeps its offset from its reference keyframe, grown by that keyframe's factor.
+	const auto follow = [&](sfm::TrackedFrame& f)
+	{
+		const auto it = r.newScales.find(f.reference);
+		if (!f.hasReference || it == r.newScales.end()) return;
+		sfm::scaleTranslation(f.T_ref_cam, it->second);
+		f.T_world_cam = r.newPoses.at(f.reference) + f.T_ref_cam;
+	};
+	// The tracker's reference is the newest keyframe, which took the full factor.
+	m_tracker.onMapRescaledLocally(r.factor);
+	if (tf)
+	{
+		follow(*tf);
+		m_lastTrackedPose = tf->T_world_cam;
+	}
+	else
+		m_lastTrackedPose.reset();
+	for (auto& f : m_frames) follow(f);
+	if (m_maps && m_metricScale->floorPlane())
+	{
+		const auto& floor = *m_metricScale->floorPlane();
+		m_maps->setFloorFromCameraHeight(floor.normal, floor.offset);
+		for (const auto& [name, sec] : m_maps->applyCorrection(r.newPoses, r.newScales))
 			m_timings.add("map_correction:" + name, sec);
 	}
 }

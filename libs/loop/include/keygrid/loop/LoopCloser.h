@@ -23,6 +23,7 @@
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/SparseMap.h>
 
+#include <atomic>
 #include <map>
 #include <optional>
 #include <set>
@@ -202,6 +203,12 @@ class LoopCloser
 	int rejectedImplausible() const;
 	/** The keyframe pose graph of the last correction (for posegraph.g2o). */
 	const std::optional<PoseGraph>& lastPoseGraph() const { return m_lastGraph; }
+	/** Monocular: the map's units are metres from now on (slam::MetricScale applied an
+	 * estimate), so loops are verified and corrected at a fixed scale (Sim3RansacOptions::
+	 * fixScale, Sim3PoseGraph::setScalesFixed); until then their scale is free. Safe to call
+	 * from another thread than process(). */
+	void setMetricUnits(bool metric) { m_metricUnits = metric; }
+	bool metricUnits() const { return m_metricUnits; }
 
    private:
 	void trainIfReady();
@@ -251,6 +258,7 @@ class LoopCloser
 	std::optional<MergeHypothesis> m_merge;
 	sfm::KeyFrameId m_lastLoopKf{0};
 	bool m_anyLoop{false};
+	std::atomic<bool> m_metricUnits{false};  //!< see setMetricUnits()
 	std::vector<LoopQueryRecord> m_queries;
 };
 

@@ -54,6 +54,10 @@ class Sim3PoseGraph
 	/** Holds a vertex fixed (rotation, translation and scale). Without any, the vertex with the
 	 * smallest id is fixed. */
 	void setFixed(KeyFrameId id, bool fixed = true);
+	/** Holds every vertex's scale at its value: the map's units are known everywhere (a
+	 * monocular map made metric), so a loop moves and turns keyframes but does not rescale
+	 * them, as ORB-SLAM's essential graph with a fixed scale (Default: false) */
+	void setScalesFixed(bool fixed) { m_scalesFixed = fixed; }
 
 	bool hasVertex(KeyFrameId id) const { return m_poses.count(id) > 0; }
 	const Sim3& pose(KeyFrameId id) const { return m_poses.at(id); }
@@ -75,6 +79,7 @@ class Sim3PoseGraph
 	std::map<KeyFrameId, Sim3> m_poses;
 	std::vector<Sim3PoseGraphEdge> m_edges;
 	std::vector<KeyFrameId> m_fixed;
+	bool m_scalesFixed{false};
 };
 
 /** The SE(3) form of a Sim(3) correction, for maps that keep rigid keyframe poses (ORB-SLAM's

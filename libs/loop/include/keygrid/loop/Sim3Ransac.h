@@ -6,7 +6,7 @@
  * Horn/Umeyama fits with scale on 3 random pairs; a pair is an inlier when each point projects
  * into the other keyframe's image close to the keypoint it was matched with (the monocular map
  * has no depth to compare 3D distances in, and its units are arbitrary, so distances are
- * measured in pixels). The best hypothesis is then refined on its inliers by minimising those
+ * measured in pixels). With fixScale the fits are rigid (s = 1). The best hypothesis is then refined on its inliers by minimising those
  * reprojection errors (Ceres, Huber loss) and the inliers re-classified.
  */
 #include <keygrid/loop/Sim3.h>
@@ -35,6 +35,12 @@ struct Sim3RansacOptions
 	int refinementRounds{2};
 	/** Seed of the sampler: the same inputs and seed give the same result (Default: 42) */
 	std::uint64_t seed{42};
+	/** Both keyframes' points are in the same known units (a monocular map made metric by
+	 * slam::MetricScale): the scale is held at 1 (hypotheses are rigid Umeyama fits, the
+	 * refinement moves rotation and translation only), as ORB-SLAM fixes it once the scale is
+	 * observable. A few tens of matches over a short baseline measure the scale far worse than
+	 * the floor does, and a scale taken from them would be spread over the loop (Default: false) */
+	bool fixScale{false};
 
 	/** Throws std::invalid_argument naming the first invalid field and its value. */
 	void validate() const;

@@ -78,6 +78,12 @@ struct CameraHeightScaleOptions : public core::FieldTableOptions<CameraHeightSca
 	 * floor. Far enough that the floor's own noise does not count against it [m]
 	 * (Default: 0.10 m) */
 	double belowDistance{0.10};
+	/** A plane with more points below it than this share of the least floor support
+	 * (minFloorShare, minFloorPoints) is not the floor (maps::FloorFrameOptions::
+	 * maxBelowShare). A monocular map keeps a few points triangulated far along their rays,
+	 * under the floor: over a long stretch of path they can outnumber half the least support
+	 * (slam::MetricScale searches its window with a generous share) (Default: 0.5) */
+	double maxBelowShare{0.5};
 	/** Largest angle between the floor's normal and the cameras' mean -y axis [deg]: covers a
 	 * camera pitched down towards the floor (Default: 40 deg) */
 	double maxTiltDeg{40.0};

@@ -156,6 +156,10 @@ class Tracker
 	 * map given metric scale): the last pose, the motion model and the last frame's pose
 	 * relative to its reference keyframe scale with it. */
 	void onMapRescaled(double s);
+	/** After the newest stretch of the map was rescaled, the reference keyframe's content by s
+	 * about it (slam::MetricScale's window rescale): the motion model and the last frame's pose
+	 * relative to its reference scale by s, and the last frame follows its reference. */
+	void onMapRescaledLocally(double s);
 	const TrackerOptions& options() const { return m_opts; }
 	/** Landmarks matched as inliers in the last frame (for diagnostics and the maps). */
 	const std::vector<LandmarkId>& lastInlierLandmarks() const { return m_lastInliers; }

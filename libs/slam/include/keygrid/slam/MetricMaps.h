@@ -119,6 +119,10 @@ class MetricMaps
 	 * applyCorrection. Throws std::invalid_argument for s not positive and finite. */
 	std::map<std::string, double> applyRescale(
 		const sfm::SparseMap& map, double s, const Eigen::Vector3d& n_floor, double d_floor);
+	/** With useFloorFromCameraHeight: the floor frame becomes that of the plane n . p + d = 0
+	 * (n towards the cameras), for the next applyCorrection to re-anchor the maps on (a
+	 * rescale of the newest stretch of path only). No-op before the first keyframe. */
+	void setFloorFromCameraHeight(const Eigen::Vector3d& n_floor, double d_floor);
 
 	/** Inserts keyframe `kf` (pose as now in the map) into every map and its depth samples
 	 * (its map points when it has no depth) into the floor estimate (none with

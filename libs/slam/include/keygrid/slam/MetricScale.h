@@ -5,14 +5,19 @@
  * unit) and the map is rescaled by it; from then on the estimate is repeated every
  * reestimate_every keyframes and applied again, so the map stays metric as it grows and its
  * scale drifts. Until the first estimate succeeds it is tried at every new keyframe; later ones
- * search the floor along the newest stretch of the path (window_path_length). The map alone is
- * rescaled here; the caller (slam::System) moves what refers to it (tracker, frames).
+ * search the floor along the newest stretch of the path (window_path_length). While that stretch
+ * is the whole map, the whole map is rescaled; once the map is longer, only the stretch is (and
+ * a factor far from 1 is refused): its scale ramps from 1 at its oldest keyframe to the factor at its
+ * middle and stays there to the newest keyframe, so the parts made metric before keep their
+ * metres. The map alone is moved
+ * here; the caller (slam::System) moves what refers to it (tracker, frames, maps).
  */
 #include <keygrid/core/FieldTableOptions.h>
 #include <keygrid/core/OptionFields.h>
 #include <keygrid/sfm/CameraHeightScale.h>
 #include <keygrid/sfm/SparseMap.h>
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -40,6 +45,14 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	 * rescales the whole map: it is the scale where the camera is now. The first estimate uses
 	 * the whole map (its units are not metres yet); 0 = always the whole map (Default: 8 m) */
 	double windowPathLength{8.0};
+	/** The floor search along the newest stretch of path (a metric map longer than the window)
+	 * takes a plane with up to this x its least support of points under it, where the other
+	 * searches take max_below_share: along a long path a monocular map keeps a few per cent of
+	 * stray points under its floor, and the stricter bound refuses most windows (a desk top is
+	 * still refused: the points under it form a plane of their own,
+	 * maps::estimateLowestFloorPlane). The map's first estimates, on a few keyframes whose scale
+	 * is not known yet, keep the stricter bound (Default: 3) */
+	double windowMaxBelowShare{3.0};
 	/** The maps' floor (floorPlane()) is the plane through the keyframe centres, camera_height
 	 * under it, when the centres lie this close to one plane (RMS distance) [m]: a camera at a
 	 * fixed height on a robot draws the floor's orientation with its whole path, where the
@@ -51,6 +64,17 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	 * of the centres along the plane's second axis: a straight path leaves the plane free to
 	 * roll about it) [m] (Default: 1 m) */
 	double pathFloorMinSpread{1.0};
+	/** Rescale the whole map by every estimate, even once the map is longer than
+	 * window_path_length, instead of the window only (see the file comment): a drift corrected
+	 * where the camera is now also rescales what was already metric (Default: false) */
+	bool rescaleWholeMap{false};
+	/** An estimate along the newest stretch that changes the scale by more than this share is
+	 * refused: the scale drifts little between two estimates, and such a factor comes from a
+	 * large plane above the floor (a desk top whose floor was hidden) taken for the floor.
+	 * Estimates over the whole map (the first ones) are not bound: a first estimate on a few
+	 * keyframes can be far off, and the next ones must be able to undo it; 0 = no bound
+	 * (Default: 0.1) */
+	double windowMaxChange{0.1};
 
 	bool enabled() const { return estimator.cameraHeight > 0; }
 	core::OptionFields fields();
@@ -64,11 +88,24 @@ class MetricScale
 	/** Throws std::invalid_argument when the options are invalid or camera_height is 0. */
 	explicit MetricScale(const MetricScaleOptions& opts);
 
+	/** What an applied estimate did to the map. */
+	struct Rescale
+	{
+		/** The estimate's factor: metres per map unit where the camera is now */
+		double factor{1.0};
+		/** Empty: the whole map was scaled by `factor` about the world origin
+		 * (SparseMap::rescale). Else the keyframes of the newest stretch of path, which alone
+		 * moved: their new poses, and the factor their landmarks grew by about them (as a Sim(3)
+		 * loop correction, loop::applySim3Corrections) */
+		std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> newPoses;
+		std::map<sfm::KeyFrameId, double> newScales;
+		bool wholeMap() const { return newScales.empty(); }
+	};
 	/** When an estimate is due (see the file comment): estimates the scale of `map` (its
-	 * keyframes and landmarks) and, when the estimate succeeds, rescales the map by it
-	 * (SparseMap::rescale) and returns the factor; nullopt when nothing was applied. The
-	 * caller holds the map's lock. */
-	std::optional<double> update(sfm::SparseMap& map);
+	 * keyframes and landmarks) and, when the estimate succeeds, rescales the map (all of it,
+	 * or its newest stretch) and says how; nullopt when nothing was applied. The caller holds
+	 * the map's lock. */
+	std::optional<Rescale> update(sfm::SparseMap& map);
 	/** The map's scale changed in places (a Sim(3) loop correction, which keeps the units of the
 	 * map's first keyframe): the next update() estimates, whenever the last estimate was. The
 	 * caller holds the map's lock. */
@@ -107,6 +144,7 @@ class MetricScale
    private:
 	MetricScaleOptions m_opts;
 	sfm::CameraHeightScaleEstimator m_estimator;
+	sfm::CameraHeightScaleEstimator m_windowEstimator;  //!< with windowMaxBelowShare
 	/** Newest keyframe id at the last estimate (ids only grow: culling does not reset it) */
 	std::optional<sfm::KeyFrameId> m_lastEstimateAt;
 	Stats m_stats;

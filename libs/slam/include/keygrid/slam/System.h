@@ -195,12 +195,16 @@ class System
 	void countFrame(const sfm::TrackedFrame& tf);
 	/** Monocular: a tracker's initialization message into m_initLog, at a bounded rate. */
 	void logInitialization(const sfm::TrackedFrame& tf);
-	/** Monocular with camera_height, after a new keyframe (map lock held): the map rescaled
-	 * when an estimate is due and succeeds, with the tracker, the frames (`tf`, the current
-	 * one, included) and the path length. */
-	/** Runs MetricScale::update and moves what refers to the map by its factor: the frames, the
-	 * tracker, the maps and `tf` (the frame being tracked; null at the end of the run). */
+	/** Monocular with camera_height, after a new keyframe (map lock held): runs
+	 * MetricScale::update and, when it rescaled the map, moves what refers to the map with it:
+	 * the tracker, the frames, the maps and `tf` (the frame being tracked; null at the end of
+	 * the run). */
 	void applyMetricScale(sfm::TrackedFrame* tf);
+	/** ... after the whole map was scaled by s about the origin (the path length too). */
+	void followWholeMapRescale(double s, sfm::TrackedFrame* tf);
+	/** ... after only the newest stretch of path was rescaled (MetricScale::Rescale): the
+	 * frames of its keyframes follow them, the maps re-anchor as after a Sim(3) loop. */
+	void followWindowRescale(const MetricScale::Rescale& r, sfm::TrackedFrame* tf);
 	/** Monocular map start: the frame that became the first keyframe references it now. */
 	void attachInitialKeyFrame(const sfm::TrackedFrame& tf);
 	/** Map insertion and loop closing of a keyframe, map lock held. `tf`: sequential mode, the
