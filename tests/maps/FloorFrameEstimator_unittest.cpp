@@ -183,6 +183,7 @@ TEST(FloorFrameEstimator, AGenerousBelowShareStillTakesTheFloorUnderADeskTop)
 		FloorFrameOptions o;
 		o.minSupport = 0.02;
 		o.maxBelowShare = 3;
+		o.searchUnderTheWinner = true;
 		const auto fit = estimateLowestFloorPlane(pts, TVector3D(0, 0, 1), cams, o);
 		ASSERT_TRUE(fit.has_value());
 		EXPECT_NEAR(fit->plane.height(TPoint3D(2, 2, 0)), 0.0, 0.02);

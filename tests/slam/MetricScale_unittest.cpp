@@ -423,3 +423,39 @@ TEST(MetricScale, TheWindowSearchTakesAFloorWithStrayPointsUnderIt)
 		}
 	}
 }
+
+// A first estimate that was wrong leaves the whole map off in scale; once the map is longer than
+// the window, the newest stretch then asks for a change beyond window_max_change. The estimate
+// over the whole map says the same, so the whole map is rescaled (exactly back to metres), where
+// a plane above the floor in the stretch alone is refused (previous test).
+TEST(MetricScale, ALargeChangeThatTheWholeMapConfirmsRescalesTheWholeMap)
+{
+	sfm::SparseMap map;
+	auto o = options();
+	o.windowPathLength = 4.2;
+	o.reestimateEvery = 1;
+	slam::MetricScale scale(o);
+	std::mt19937 rng(6);
+	std::vector<sfm::KeyFrameId> ids;
+	// Keyframes 0.5 m apart and floor points ahead of them, in a map of `unit` map units per metre.
+	const auto addStretch = [&](int from, int to, double unit)
+	{
+		for (int k = from; k < to; k++) ids.push_back(map.addKeyFrame(keyFrame(camera(0.5 * unit * k, 0, unit * kCameraHeight, 0), 400)).id);
+		std::uniform_real_distribution<double> U(0, 1);
+		for (int k = from; k + 1 < to; k += 2)
+			for (int i = 0; i < 400; i++)
+				map.addObservation(
+					map.addLandmark({unit * (0.5 * k + 1.0 + 3.0 * U(rng)), unit * (-2.0 + 4.0 * U(rng)), 0.0}, ids[k + 1], i), ids[k], i);
+	};
+	addStretch(0, 10, 1.0);
+	ASSERT_TRUE(scale.update(map).has_value()) << scale.stats().lastMessage;
+	// The map comes out 30 % too large (as after a first estimate on another plane), then grows.
+	map.rescale(1.3);
+	addStretch(10, 30, 1.3);
+	const auto s = scale.update(map);
+	ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+	EXPECT_TRUE(s->wholeMap());
+	EXPECT_NEAR(s->factor, 1 / 1.3, 1e-6);
+	EXPECT_NE(scale.log().back().find("the whole map agrees"), std::string::npos) << scale.log().back();
+	for (const auto& [id, kf] : map.keyframes()) EXPECT_NEAR(kf.T_world_cam.z(), kCameraHeight, 1e-6) << id;
+}

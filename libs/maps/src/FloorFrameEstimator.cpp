@@ -425,10 +425,10 @@ std::optional<FloorPlaneFit> estimateLowestFloorPlane(
 		up = r.normal;
 		tiltDeg = o.refineTiltDeg;
 	}
-	// A generous maxBelowShare lets the points under a plane be as many as the least support:
-	// when they form a large plane of their own (the floor under a desk top), that lower plane
-	// is the floor; points scattered under the floor (a monocular map's stray ones) form none.
-	if (best && best->below >= minSupport)
+	// searchUnderTheWinner: the samples under the plane found (a clear one, as a generous
+	// maxBelowShare lets through, or the fallback) may form a large plane of their own (the
+	// floor under a desk top): that lower plane is the floor. Scattered stray samples form none.
+	if (o.searchUnderTheWinner && best && best->below >= minSupport)
 	{
 		std::vector<TPoint3D> under;
 		std::vector<double> underWeights;

@@ -179,6 +179,7 @@ CameraHeightScaleResult CameraHeightScaleEstimator::estimate(
 	search.inlierDistance = o.inlierDistance;
 	search.belowDistance = o.belowDistance;
 	search.maxBelowShare = o.maxBelowShare;
+	search.searchUnderTheWinner = true;
 	search.maxTiltDeg = o.maxTiltDeg;
 	search.hypotheses = o.hypotheses;
 	search.minSupport = o.minFloorShare;

@@ -154,6 +154,30 @@ sfm::CameraHeightScaleOptions withMaxBelowShare(sfm::CameraHeightScaleOptions o,
 }
 }  // namespace
 
+sfm::CameraHeightScaleResult MetricScale::estimateOver(
+	const sfm::SparseMap& map, const std::vector<sfm::KeyFrameId>& keyframes, const sfm::CameraHeightScaleEstimator& estimator,
+	std::size_t* pointsSearched) const
+{
+	std::vector<mrpt::poses::CPose3D> poses;
+	poses.reserve(keyframes.size());
+	for (const sfm::KeyFrameId id : keyframes) poses.push_back(map.keyframe(id).T_world_cam);
+	// The well-triangulated points first; when they give no estimate (too few yet, or no clear
+	// floor among them), every point.
+	std::vector<Eigen::Vector3d> points, all;
+	const double minCos = std::cos(m_opts.minPointParallaxDeg * M_PI / 180.0);
+	const bool wholeMap = keyframes.size() == map.numKeyFrames();
+	for (const auto& [id, lm] : map.landmarks())
+	{
+		if (!wholeMap && !observedFrom(lm, keyframes)) continue;
+		all.push_back(lm.p_world);
+		if (!(sfm::largestParallaxCos(map, lm) > minCos)) points.push_back(lm.p_world);
+	}
+	auto r = estimator.estimate(poses, points);
+	if (!r.ok && points.size() < all.size()) r = estimator.estimate(poses, all);
+	if (pointsSearched) *pointsSearched = all.size();
+	return r;
+}
+
 MetricScale::MetricScale(const MetricScaleOptions& opts)
 	: m_opts(opts), m_estimator(opts.estimator), m_windowEstimator(withMaxBelowShare(opts.estimator, opts.windowMaxBelowShare))
 {
@@ -169,28 +193,29 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 	if (static_cast<int>(map.numKeyFrames()) < m_opts.estimator.minKeyframes) return std::nullopt;
 	m_lastEstimateAt = newest;
 	const auto window = estimateWindow(map, metric() ? m_opts.windowPathLength : 0.0);
-	std::vector<mrpt::poses::CPose3D> poses;
-	poses.reserve(window.size());
-	for (const sfm::KeyFrameId id : window) poses.push_back(map.keyframe(id).T_world_cam);
-	// The well-triangulated points first; when they give no estimate (too few yet, or no clear
-	// floor among them), every point.
-	std::vector<Eigen::Vector3d> points, all;
-	const double minCos = std::cos(m_opts.minPointParallaxDeg * M_PI / 180.0);
-	const bool wholeMap = window.size() == map.numKeyFrames();
-	for (const auto& [id, lm] : map.landmarks())
-	{
-		if (!wholeMap && !observedFrom(lm, window)) continue;
-		all.push_back(lm.p_world);
-		if (!(sfm::largestParallaxCos(map, lm) > minCos)) points.push_back(lm.p_world);
-	}
-	const auto& estimator = wholeMap ? m_estimator : m_windowEstimator;
-	auto r = estimator.estimate(poses, points);
-	if (!r.ok && points.size() < all.size()) r = estimator.estimate(poses, all);
+	bool wholeMap = window.size() == map.numKeyFrames();
+	std::size_t pointsSearched = 0;
+	auto r = estimateOver(map, window, wholeMap ? m_estimator : m_windowEstimator, &pointsSearched);
 	if (r.ok && !wholeMap && m_opts.windowMaxChange > 0 && std::abs(r.scale - 1) > m_opts.windowMaxChange)
 	{
-		r.ok = false;
-		r.message = "refused: a change of x" + std::to_string(r.scale) + " along the newest stretch exceeds window_max_change = " +
-					std::to_string(m_opts.windowMaxChange) + " (a plane above the floor?); " + r.message;
+		// Too large a change for a drift. Unless the whole map says the same (its scale was off
+		// before the stretch too: a first estimate that took another plane for the floor), it
+		// comes from a plane above the floor and is refused.
+		const auto whole = estimateOver(map, estimateWindow(map, 0.0), m_estimator);
+		if (whole.ok && std::abs(whole.scale - 1) > m_opts.windowMaxChange &&
+			std::abs(std::log(whole.scale / r.scale)) < m_opts.windowMaxChange)
+		{
+			r = whole;
+			r.message = "the whole map agrees with the newest stretch's x" + std::to_string(r.scale) + "; " + r.message;
+			wholeMap = true;
+		}
+		else
+		{
+			r.ok = false;
+			r.message = "refused: a change of x" + std::to_string(r.scale) + " along the newest stretch exceeds window_max_change = " +
+						std::to_string(m_opts.windowMaxChange) + " and the whole map " +
+						(whole.ok ? "says x" + std::to_string(whole.scale) : "gives no estimate") + " (a plane above the floor?); " + r.message;
+		}
 	}
 	m_stats.estimates++;
 	m_stats.lastMessage = r.message;
@@ -217,7 +242,7 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 	}
 	if (m_log.size() < kMaxLogLines)
 		m_log.push_back(
-			"keyframe " + std::to_string(newest) + ", " + std::to_string(window.size()) + " keyframes, " + std::to_string(all.size()) +
+			"keyframe " + std::to_string(newest) + ", " + std::to_string(window.size()) + " keyframes, " + std::to_string(pointsSearched) +
 			" points: " + (r.ok ? "x" + std::to_string(r.scale) + (applied.wholeMap() ? " (whole map), " : " (window), ") : "") +
 			r.message + (r.ok ? "; " + floorSource : ""));
 	if (!r.ok) return std::nullopt;

@@ -91,6 +91,12 @@ struct FloorFrameOptions : public core::FieldTableOptions<FloorFrameOptions>
 	/** Every keyframe camera but 5 % must be at least this high above the floor [m]
 	 * (Default: 0.2 m) */
 	double minCameraHeight{0.2};
+	/** estimateLowestFloorPlane only, not an INI key: when the plane found has at least the
+	 * least support's worth of samples below it, search those samples alone, and a large plane
+	 * among them (the floor under a desk top) is the floor instead; stray samples scattered
+	 * under the floor form none. Set by the monocular camera-height estimator, whose maps keep
+	 * such stray points (Default: false) */
+	bool searchUnderTheWinner{false};
 	/** Random seed of the reservoir and of RANSAC (Default: 1) */
 	uint32_t seed{1};
 

@@ -70,7 +70,9 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	bool rescaleWholeMap{false};
 	/** An estimate along the newest stretch that changes the scale by more than this share is
 	 * refused: the scale drifts little between two estimates, and such a factor comes from a
-	 * large plane above the floor (a desk top whose floor was hidden) taken for the floor.
+	 * large plane above the floor (a desk top whose floor was hidden) taken for the floor;
+	 * unless an estimate over the whole map agrees with it (within this share), which then
+	 * rescales the whole map (its scale was off before the stretch too).
 	 * Estimates over the whole map (the first ones) are not bound: a first estimate on a few
 	 * keyframes can be far off, and the next ones must be able to undo it; 0 = no bound
 	 * (Default: 0.1) */
@@ -142,6 +144,12 @@ class MetricScale
 	bool metric() const { return m_stats.applied > 0; }
 
    private:
+	/** The estimator on `keyframes` (ascending ids) and the map points they observe (every
+	 * point when they are the whole map): the well-triangulated points first, then all. */
+	sfm::CameraHeightScaleResult estimateOver(
+		const sfm::SparseMap& map, const std::vector<sfm::KeyFrameId>& keyframes,
+		const sfm::CameraHeightScaleEstimator& estimator, std::size_t* pointsSearched = nullptr) const;
+
 	MetricScaleOptions m_opts;
 	sfm::CameraHeightScaleEstimator m_estimator;
 	sfm::CameraHeightScaleEstimator m_windowEstimator;  //!< with windowMaxBelowShare
