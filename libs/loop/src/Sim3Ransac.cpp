@@ -116,7 +116,6 @@ Sim3 refine(const std::vector<Sim3Match>& ms, const std::vector<char>& inlier, c
 	for (std::size_t i = 0; i < ms.size(); ++i)
 		if (inlier[i])
 			problem.AddResidualBlock(Sim3ReprojectionError::Create(ms[i], K), new ceres::HuberLoss(std::sqrt(chi2)), q.coeffs().data(), t.data(), &logS);
-	if (problem.NumResidualBlocks() == 0) return S0;
 	problem.SetManifold(q.coeffs().data(), new ceres::EigenQuaternionManifold());
 	if (fixScale) problem.SetParameterBlockConstant(&logS);
 	ceres::Solver::Options o;

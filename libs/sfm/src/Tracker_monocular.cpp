@@ -240,17 +240,21 @@ bool Tracker::startMonocularMap(Current& cur, const TwoViewResult& r, const std:
 	return true;
 }
 
-void Tracker::onMapRescaled(double s)
+void Tracker::scaleMotion(double s)
 {
-	scaleTranslation(m_lastPose, s);
 	if (m_velocity) scaleTranslation(*m_velocity, s);
 	if (m_lastRelative) scaleTranslation(m_lastRelative->second, s);
 }
 
+void Tracker::onMapRescaled(double s)
+{
+	scaleTranslation(m_lastPose, s);
+	scaleMotion(s);
+}
+
 void Tracker::onMapRescaledLocally(double s)
 {
-	if (m_velocity) scaleTranslation(*m_velocity, s);
-	if (m_lastRelative) scaleTranslation(m_lastRelative->second, s);
+	scaleMotion(s);
 	onMapCorrected();
 }
 

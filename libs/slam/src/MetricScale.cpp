@@ -143,10 +143,7 @@ double medianHeight(const sfm::SparseMap& map, const std::vector<sfm::KeyFrameId
 	std::nth_element(h.begin(), h.begin() + static_cast<std::ptrdiff_t>(h.size() / 2), h.end());
 	return h[h.size() / 2];
 }
-}  // namespace
 
-namespace
-{
 sfm::CameraHeightScaleOptions withMaxBelowShare(sfm::CameraHeightScaleOptions o, double share)
 {
 	o.maxBelowShare = share;
@@ -224,21 +221,21 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 	if (r.ok)
 	{
 		// The whole map while the window is all of it or when asked for; else the window alone.
-		std::optional<FloorPlane> found;
+		FloorPlane found{r.floorNormal, 0.0};
 		if (wholeMap || m_opts.rescaleWholeMap || window.size() < 2)
 		{
 			map.rescale(r.scale);
 			applied.factor = r.scale;
 			// The plane was found in the map before the rescale: its offset scales with the map.
-			found = FloorPlane{r.floorNormal, r.floorOffset * r.scale};
+			found.offset = r.floorOffset * r.scale;
 		}
 		else
 		{
 			applied = rescaleWindow(map, window, r.scale);
 			// The floor the estimate found, camera_height under the rescaled window.
-			found = FloorPlane{r.floorNormal, m_opts.estimator.cameraHeight - medianHeight(map, window, r.floorNormal)};
+			found.offset = m_opts.estimator.cameraHeight - medianHeight(map, window, r.floorNormal);
 		}
-		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource).value_or(*found);
+		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource).value_or(found);
 	}
 	if (m_log.size() < kMaxLogLines)
 		m_log.push_back(

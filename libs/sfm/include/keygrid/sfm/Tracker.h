@@ -165,6 +165,9 @@ class Tracker
 	const std::vector<LandmarkId>& lastInlierLandmarks() const { return m_lastInliers; }
 
    private:
+	/** The motion model and the last frame's pose relative to its reference, scaled by s. */
+	void scaleMotion(double s);
+
 	struct Current
 	{
 		const core::Frame* frame{nullptr};
