@@ -1,4 +1,4 @@
-// Threaded mode's keyframe deferral (Tracker::deferKeyFramesWhile, [slam] busy_keyframe_ratio),
+// Threaded mode's keyframe deferral (Tracker::deferKeyFramesWhile, [slam] / [monocular] busy_keyframe_ratio),
 // made deterministic: the tracker and local mapping run in turn on a rendered sequence while
 // the "mapping busy" answer is fixed. Never busy: exactly the keyframes of the plain tracker.
 // Always busy: keyframes only where tracking is weak or, when no frame counts as weak, at the
@@ -8,6 +8,7 @@
 #include <keygrid/sfm/LocalMapper.h>
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/slam/SlamConfig.h>
+#include <mrpt/config/CConfigFileMemory.h>
 
 #include "TestData.h"
 
@@ -91,4 +92,24 @@ TEST(KeyFrameDeferral, BusyMappingDefersKeyFramesToWeakTrackingOrTheTimeout)
 	for (std::size_t k = 1; k < fastBusy.keyframeFrames.size(); k++)
 		beforeTimeout |= fastBusy.keyframeFrames[k] - fastBusy.keyframeFrames[k - 1] < 3 * 30;  // frame indices
 	EXPECT_TRUE(beforeTimeout);
+}
+
+TEST(KeyFrameDeferral, MonocularModeDefersWithItsOwnShare)
+{
+	// The share comes from [monocular] in monocular mode, from [slam] otherwise, and only
+	// threaded mode with a mapping lag defers at all.
+	const auto config = [](const std::string& slamKeys)
+	{
+		mrpt::config::CConfigFileMemory ini("[slam]\n" + slamKeys + "\nbusy_keyframe_ratio = 0.3\n[monocular]\nbusy_keyframe_ratio = 0.7\n");
+		return slam::SlamConfig::FromConfig(ini, "test");
+	};
+	EXPECT_DOUBLE_EQ(config("mode = threaded\nsensor = monocular").deferralRatio(), 0.7);
+	EXPECT_DOUBLE_EQ(config("mode = threaded\nsensor = rgbd").deferralRatio(), 0.3);
+	EXPECT_DOUBLE_EQ(config("mode = threaded\nsensor = monocular\nmapping_lag = 0").deferralRatio(), 0.0);
+	EXPECT_DOUBLE_EQ(config("mode = sequential\nsensor = monocular").deferralRatio(), 0.0);
+	// The defaults: 0.6 for a monocular camera, 0.35 for RGB-D.
+	mrpt::config::CConfigFileMemory mono("[slam]\nmode = threaded\nsensor = monocular\n");
+	EXPECT_DOUBLE_EQ(slam::SlamConfig::FromConfig(mono, "test").deferralRatio(), 0.6);
+	mrpt::config::CConfigFileMemory rgbd("[slam]\nmode = threaded\n");
+	EXPECT_DOUBLE_EQ(slam::SlamConfig::FromConfig(rgbd, "test").deferralRatio(), 0.35);
 }

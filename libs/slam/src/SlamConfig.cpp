@@ -85,6 +85,12 @@ void forEachSection(Config& cfg, Visit&& visit)
 }
 }  // namespace
 
+double SlamConfig::deferralRatio() const
+{
+	if (mode != RunMode::Threaded || mappingLag == 0) return 0.0;
+	return sensor == Sensor::Monocular ? tracker.mono.busyKeyFrameRatio : busyKeyFrameRatio;
+}
+
 void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)
 {
 	fields().read(c, "slam");

@@ -3,6 +3,8 @@
 # with the camera's height above the floor ([camera_height_scale] camera_height). Cases:
 #   room    config/sim/room_loop.ini rendered as a plain camera (camera at 1.30 m)
 #   office  config/sim/office_loop.ini rendered the same way (camera at 1.40 m; 3300 frames)
+#   corridor config/sim/corridor_loop.ini (1.40 m, 1020 frames), survey config/sim/room_survey.ini
+#           (1.30 m, 1950 frames): validation scenes, run with the height only (not in the defaults)
 #   fr1     ../shared/data/tum_fr1_rpy_first250 with its depth ignored (no height: hand-held)
 #   desk    ../shared/data/tum_fr1_desk_9frames with its depth ignored
 # Prints per run: the frame the map started at, frames tracked after it, the ATE of the tracked
@@ -21,6 +23,7 @@
 # Renderings are made once per --out folder; the TUM cases are skipped when their data is absent.
 #
 #   tests/benchmarks/slam/monocular.sh [--build DIR] [--out DIR] [--cases "room office fr1 desk"] [--help]
+#   (also: --cases "corridor survey")
 # Results: doc/evaluation.md, "Monocular mode".
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
@@ -149,6 +152,11 @@ for c in $cases; do
       d="$(render office_loop office_loop)"
       run office_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0 office_loop
       run office_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.40 office_loop ;;
+    corridor|survey)
+      # Validation scenes (not tuned on): with camera_height only; threaded runs by hand.
+      scene=corridor_loop; h=1.40; [ "$c" = survey ] && scene=room_survey h=1.30
+      d="$(render $scene $scene)"
+      run "${scene}_h" "$mono" "$d/tum" "$d/groundtruth.txt" $h $scene ;;
     fr1|desk)
       seq=tum_fr1_rpy_first250; [ "$c" = desk ] && seq=tum_fr1_desk_9frames
       if [ -f "$data/$seq/groundtruth.txt" ]; then
@@ -156,6 +164,6 @@ for c in $cases; do
       else
         echo "monocular.sh: $data/$seq not found: case $c skipped" >&2
       fi ;;
-    *) die "unknown case '$c' (room office fr1 desk)" ;;
+    *) die "unknown case '$c' (room office corridor survey fr1 desk)" ;;
   esac
 done

@@ -55,6 +55,14 @@ struct MonocularOptions : public core::FieldTableOptions<MonocularOptions>
 	 * keyframe's (ORB-SLAM2's monocular 0.9; without depth only keyframes make new landmarks,
 	 * so they come more often than in RGB-D mode) (Default: 0.9) */
 	double keyFrameTrackedRatio{0.9};
+	/** Threaded mode with [slam] mapping_lag > 0: replaces [slam] busy_keyframe_ratio in
+	 * monocular mode. While local mapping is still working on a keyframe, tracking inserts a
+	 * new one only below this share of the reference keyframe's landmarks (or at the keyframe
+	 * timeout). Higher than the RGB-D share: a monocular frame brings no landmarks of its own,
+	 * only keyframes do (once local mapping has triangulated them), so deferring keyframes until
+	 * tracking has lost most of its reference's landmarks starves the map in a fast turn
+	 * (doc/frontend.md "Monocular mode"); 0 = insert whenever tracking asks (Default: 0.6) */
+	double busyKeyFrameRatio{0.6};
 	/** Reference-keyframe landmarks counted by that ratio: those seen by at least this many
 	 * keyframes, 2 while the map has two keyframes (Default: 3, ORB-SLAM2's) */
 	int keyFrameRefMinObservations{3};

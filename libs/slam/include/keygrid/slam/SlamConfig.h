@@ -114,8 +114,13 @@ struct SlamConfig
 	 * share of the reference keyframe's landmarks (ORB-SLAM2's rule, which uses 0.25); the
 	 * frames in between are tracked against the map being refined. Lower: fewer keyframes,
 	 * faster and less accurate; higher: the reverse (doc/frontend.md "Modes"). 0 = insert
-	 * whenever tracking asks, busy or not. (Default: 0.35) */
+	 * whenever tracking asks, busy or not. Monocular mode takes [monocular] busy_keyframe_ratio
+	 * instead. (Default: 0.35) */
 	double busyKeyFrameRatio{0.35};
+	/** The share that defers keyframes in threaded mode: busy_keyframe_ratio, in monocular
+	 * mode [monocular] busy_keyframe_ratio; 0 when no keyframe is deferred (sequential mode,
+	 * mapping_lag 0). */
+	double deferralRatio() const;
 	sfm::FeatureOptions features;
 	sfm::TrackerOptions tracker;
 	sfm::LocalMapperOptions mapping;
