@@ -40,14 +40,14 @@ System::System(const SlamConfig& cfg)
 		// instead of an ever longer backlog on a slow machine).
 		m_mappingQueue = std::make_unique<core::BoundedQueue<KeyFrameJob>>(4);
 		m_loopQueue = std::make_unique<core::BoundedQueue<KeyFrameJob>>(16);
-		if (cfg.deferralRatio() > 0)
+		if (const double share = cfg.deferralRatio(); share > 0)
 			m_tracker.deferKeyFramesWhile(
 				[this]
 				{
 					std::lock_guard<std::mutex> lk(m_statsMutex);
 					return m_jobsMapped < m_jobsQueued;
 				},
-				cfg.deferralRatio());
+				share);
 		m_mapping = std::thread([this] { mappingThread(); });
 		m_loopClosing = std::thread([this] { loopClosingThread(); });
 	}
