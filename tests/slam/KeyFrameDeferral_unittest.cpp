@@ -12,6 +12,7 @@
 
 #include "TestData.h"
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 
@@ -24,6 +25,8 @@ namespace
 struct Run
 {
 	std::vector<std::size_t> keyframeFrames;
+	/** Per keyframe: inserted while mapping was busy (TrackedFrame::keyFrameWhileMappingBusy). */
+	std::vector<bool> whileBusy;
 	std::size_t tracked{0}, frames{0};
 };
 
@@ -47,6 +50,7 @@ Run track(const std::string& tumDir, const std::optional<std::pair<std::function
 		if (tf.newKeyFrame)
 		{
 			run.keyframeFrames.push_back(tf.index);
+			run.whileBusy.push_back(tf.keyFrameWhileMappingBusy);
 			mapper.process(tf.keyframe, frame.camera.pinhole());
 		}
 	}
@@ -74,6 +78,7 @@ TEST(KeyFrameDeferral, BusyMappingDefersKeyFramesToWeakTrackingOrTheTimeout)
 	const auto idle = track(dir + "/tum", Deferral([&] { return ++asked, false; }, 0.25), 100);
 	EXPECT_EQ(idle.keyframeFrames, plain.keyframeFrames);
 	EXPECT_GT(asked, 0);  // consulted, never deferring
+	EXPECT_EQ(std::count(idle.whileBusy.begin(), idle.whileBusy.end(), true), 0);
 
 	// Busy, and no frame tracks below 1 % of its reference: only the timeout (config/sim.ini
 	// keeps the default of 30 frames) inserts keyframes.
@@ -88,10 +93,17 @@ TEST(KeyFrameDeferral, BusyMappingDefersKeyFramesToWeakTrackingOrTheTimeout)
 	const auto fastBusy = track(dir + "/tum", Deferral([] { return true; }, 0.25), 66, 3);
 	EXPECT_EQ(fastBusy.tracked, 66u);
 	EXPECT_LT(fastBusy.keyframeFrames.size(), fastPlain.keyframeFrames.size());
+	// A keyframe before the timeout was inserted despite the busy mapping (tracking weak) and
+	// says so; one at the timeout does not.
 	bool beforeTimeout = false;
 	for (std::size_t k = 1; k < fastBusy.keyframeFrames.size(); k++)
-		beforeTimeout |= fastBusy.keyframeFrames[k] - fastBusy.keyframeFrames[k - 1] < 3 * 30;  // frame indices
+	{
+		const bool early = fastBusy.keyframeFrames[k] - fastBusy.keyframeFrames[k - 1] < 30;  // frame indices: the timeout counts them
+		beforeTimeout |= early;
+		EXPECT_EQ(fastBusy.whileBusy[k], early) << "keyframe at frame " << fastBusy.keyframeFrames[k];
+	}
 	EXPECT_TRUE(beforeTimeout);
+	EXPECT_FALSE(fastBusy.whileBusy.front());  // the map's first keyframe
 }
 
 TEST(KeyFrameDeferral, MonocularModeDefersWithItsOwnShare)
@@ -112,4 +124,25 @@ TEST(KeyFrameDeferral, MonocularModeDefersWithItsOwnShare)
 	EXPECT_DOUBLE_EQ(slam::SlamConfig::FromConfig(mono, "test").deferralRatio(), 0.6);
 	mrpt::config::CConfigFileMemory rgbd("[slam]\nmode = threaded\n");
 	EXPECT_DOUBLE_EQ(slam::SlamConfig::FromConfig(rgbd, "test").deferralRatio(), 0.35);
+}
+
+TEST(KeyFrameDeferral, WaitingAfterAWeakKeyFrameIsReadPerSensor)
+{
+	// [monocular] wait_for_weak_keyframes in monocular mode, [slam] otherwise; never where no
+	// keyframe is deferred (sequential mode, mapping_lag 0, a share of 0).
+	const auto config = [](const std::string& slamKeys)
+	{
+		mrpt::config::CConfigFileMemory ini("[slam]\n" + slamKeys + "\nwait_for_weak_keyframes = true\n[monocular]\nwait_for_weak_keyframes = false\n");
+		return slam::SlamConfig::FromConfig(ini, "test");
+	};
+	EXPECT_FALSE(config("mode = threaded\nsensor = monocular").waitsForWeakKeyFrames());
+	EXPECT_TRUE(config("mode = threaded\nsensor = rgbd").waitsForWeakKeyFrames());
+	EXPECT_FALSE(config("mode = threaded\nsensor = rgbd\nmapping_lag = 0").waitsForWeakKeyFrames());
+	EXPECT_FALSE(config("mode = threaded\nsensor = rgbd\nbusy_keyframe_ratio = 0").waitsForWeakKeyFrames());
+	EXPECT_FALSE(config("mode = sequential\nsensor = rgbd").waitsForWeakKeyFrames());
+	// The defaults: on for a monocular camera, off for RGB-D (whose rule is unchanged).
+	mrpt::config::CConfigFileMemory mono("[slam]\nmode = threaded\nsensor = monocular\n");
+	EXPECT_TRUE(slam::SlamConfig::FromConfig(mono, "test").waitsForWeakKeyFrames());
+	mrpt::config::CConfigFileMemory rgbd("[slam]\nmode = threaded\n");
+	EXPECT_FALSE(slam::SlamConfig::FromConfig(rgbd, "test").waitsForWeakKeyFrames());
 }

@@ -19,6 +19,7 @@ core::OptionFields MonocularOptions::fields()
 	f.add("init_ba_iterations", initBaIterations, "bundle adjustment iterations of the two first keyframes", R::positive());
 	f.add("keyframe_tracked_ratio", keyFrameTrackedRatio, "new keyframe below this share of the reference's landmarks", R::aboveUpTo(0, 1));
 	f.add("busy_keyframe_ratio", busyKeyFrameRatio, "threaded, lag > 0, monocular: replaces [slam] busy_keyframe_ratio (0: off)", R::inRange(0, 1));
+	f.add("wait_for_weak_keyframes", waitForWeakKeyFrames, "threaded, lag > 0, monocular: replaces [slam] wait_for_weak_keyframes");
 	f.add("keyframe_ref_min_observations", keyFrameRefMinObservations, "reference landmarks counted: seen by >= this many keyframes", R::positive());
 	f.append(twoView.fields());
 	return f;

@@ -81,6 +81,14 @@ void Tracker::deferKeyFramesWhile(std::function<bool()> mappingBusy, double weak
 	m_deferWeakRatio = weakRatio;
 }
 
+Tracker::KeyFrameNeed Tracker::insertUnlessDeferred(bool wanted, bool timeout, int inliers, int refMatches) const
+{
+	if (!wanted) return KeyFrameNeed::No;
+	if (timeout || !m_mappingBusy || !m_mappingBusy()) return KeyFrameNeed::Yes;
+	// Local mapping still busy with the last keyframe: wait for it unless tracking is weak.
+	return inliers < m_deferWeakRatio * refMatches ? KeyFrameNeed::YesWhileMappingBusy : KeyFrameNeed::No;
+}
+
 bool Tracker::hocUsable(LandmarkId id, const Current& cur)
 {
 	// Untimed: callers time whole selection passes, as a thread-CPU clock read costs more than
@@ -181,10 +189,11 @@ TrackedFrame Tracker::track(const core::Frame& frame, FrameFeatures features)
 			out.observations.push_back(ob);
 		}
 		if (m_hoc) updateHoc(cur, out);
-		if (m_insertKeyFrames && needKeyFrame(cur))
+		if (const auto need = m_insertKeyFrames ? needKeyFrame(cur) : KeyFrameNeed::No; need != KeyFrameNeed::No)
 		{
 			out.keyframe = createKeyFrame(cur);
 			out.newKeyFrame = true;
+			out.keyFrameWhileMappingBusy = need == KeyFrameNeed::YesWhileMappingBusy;
 		}
 	}
 	else
@@ -563,7 +572,7 @@ void Tracker::updateHoc(Current& cur, TrackedFrame& out)
 	m_hocSelectionSeconds = 0;
 }
 
-bool Tracker::needKeyFrame(const Current& cur) const
+Tracker::KeyFrameNeed Tracker::needKeyFrame(const Current& cur) const
 {
 	if (m_opts.monocular) return needKeyFrameMonocular(cur);
 	const int sinceLast = static_cast<int>(cur.frame->index - m_lastKfFrame);
@@ -583,9 +592,7 @@ bool Tracker::needKeyFrame(const Current& cur) const
 	const double ratio = m_map.numKeyFrames() < 2 ? kTrackedRatioWithOneKeyFrame : m_opts.keyFrameTrackedRatio;
 	const bool timeout = sinceLast >= m_opts.maxFramesBetweenKeyFrames;
 	const bool weak = cur.inliers < ratio * refMatches || needClose;
-	// Local mapping still busy with the last keyframe: wait for it unless tracking is weak.
-	if (!timeout && m_mappingBusy && !(cur.inliers < m_deferWeakRatio * refMatches) && m_mappingBusy()) return false;
-	return (timeout || weak) && cur.inliers > detail::kMinKeyFrameInliers;
+	return insertUnlessDeferred((timeout || weak) && cur.inliers > detail::kMinKeyFrameInliers, timeout, cur.inliers, refMatches);
 }
 
 KeyFrame Tracker::keyFrameOf(const Current& cur)

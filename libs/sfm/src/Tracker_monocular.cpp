@@ -258,7 +258,7 @@ void Tracker::onMapRescaledLocally(double s)
 	onMapCorrected();
 }
 
-bool Tracker::needKeyFrameMonocular(const Current& cur) const
+Tracker::KeyFrameNeed Tracker::needKeyFrameMonocular(const Current& cur) const
 {
 	const auto& mo = m_opts.mono;
 	const int sinceLast = static_cast<int>(cur.frame->index - m_lastKfFrame);
@@ -266,9 +266,7 @@ bool Tracker::needKeyFrameMonocular(const Current& cur) const
 	const int refMatches = m_map.hasKeyFrame(m_refKf) ? m_map.keyframe(m_refKf).trackedLandmarks(minObs, &m_map) : 0;
 	const bool timeout = sinceLast >= m_opts.maxFramesBetweenKeyFrames;
 	const bool weak = cur.inliers < mo.keyFrameTrackedRatio * refMatches;
-	// Local mapping still busy with the last keyframe: wait for it unless tracking is weak.
-	if (!timeout && m_mappingBusy && !(cur.inliers < m_deferWeakRatio * refMatches) && m_mappingBusy()) return false;
-	return (timeout || weak) && cur.inliers > detail::kMinKeyFrameInliers;
+	return insertUnlessDeferred((timeout || weak) && cur.inliers > detail::kMinKeyFrameInliers, timeout, cur.inliers, refMatches);
 }
 
 }  // namespace keygrid::sfm

@@ -62,6 +62,7 @@ core::OptionFields SlamConfig::fields()
 		"preset (fr1 fr2 fr3 icl kinect), INI file, or auto");
 	f.add("mapping_lag", mappingLag, "threaded: keyframes local mapping may lag behind tracking (0: none)", R::inRange(0, 5));
 	f.add("busy_keyframe_ratio", busyKeyFrameRatio, "threaded, lag > 0: no keyframe while mapping is busy unless tracking < this x reference (0: off)", R::inRange(0, 1));
+	f.add("wait_for_weak_keyframes", waitForWeakKeyFrames, "threaded, lag > 0: after a keyframe inserted while mapping was busy, wait until mapping is done");
 	return f;
 }
 
@@ -89,6 +90,12 @@ double SlamConfig::deferralRatio() const
 {
 	if (mode != RunMode::Threaded || mappingLag == 0) return 0.0;
 	return sensor == Sensor::Monocular ? tracker.mono.busyKeyFrameRatio : busyKeyFrameRatio;
+}
+
+bool SlamConfig::waitsForWeakKeyFrames() const
+{
+	if (deferralRatio() == 0) return false;
+	return sensor == Sensor::Monocular ? tracker.mono.waitForWeakKeyFrames : waitForWeakKeyFrames;
 }
 
 void SlamConfig::loadFromConfigFile(const mrpt::config::CConfigFileBase& c)

@@ -5,7 +5,6 @@
 #include <keygrid/slam/System.h>
 
 #include <chrono>
-#include <cstdlib>
 #include <future>
 #include <set>
 #include <stdexcept>
@@ -182,16 +181,14 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	countFrame(tf);
 	const bool queueKeyFrame = tf.newKeyFrame && m_mappingQueue;
 	m_frames.push_back(std::move(tf));
-	if (queueKeyFrame && initialJob)
-	{
-		if (!m_mappingQueue->push(*initialJob)) throwIfBackgroundFailed();
-		m_jobsQueued++;
-	}
+	const bool whileBusy = m_frames.back().keyFrameWhileMappingBusy;
+	if (queueKeyFrame && initialJob) queueForMapping(*initialJob);
 	if (queueKeyFrame)
 	{
-		if (!m_mappingQueue->push(job)) throwIfBackgroundFailed();
-		m_jobsQueued++;
-		waitForMapping();
+		queueForMapping(job);
+		// A keyframe tracking had to insert while local mapping was busy: the next frames
+		// track against its landmarks (SlamConfig::waitsForWeakKeyFrames).
+		waitForMapping(whileBusy && m_cfg.waitsForWeakKeyFrames() ? 0 : static_cast<std::size_t>(m_cfg.mappingLag));
 	}
 	return m_frames.back();
 }
@@ -486,11 +483,17 @@ std::map<std::string, double> System::publishCorrection(const PoseCorrection& c,
 	return seconds;
 }
 
-void System::waitForMapping()
+void System::queueForMapping(const KeyFrameJob& job)
+{
+	if (!m_mappingQueue->push(job)) throwIfBackgroundFailed();
+	std::lock_guard<std::mutex> lk(m_statsMutex);
+	m_jobsQueued++;
+}
+
+void System::waitForMapping(std::size_t lag)
 {
 	const auto t0 = std::chrono::steady_clock::now();
 	std::unique_lock<std::mutex> lk(m_statsMutex);
-	const auto lag = static_cast<std::size_t>(m_cfg.mappingLag);
 	m_jobMapped.wait(lk, [&] { return m_jobsMapped + lag >= m_jobsQueued || !m_backgroundError.empty(); });
 	lk.unlock();
 	m_timings.add("mapping_wait", secondsSince(t0));

@@ -22,15 +22,18 @@
 # voxels the keyframes saw within 4 m, hazard voxels (true voxels called free, no map voxel near).
 # Renderings are made once per --out folder; the TUM cases are skipped when their data is absent.
 #
-#   tests/benchmarks/slam/monocular.sh [--build DIR] [--out DIR] [--cases "room office fr1 desk"] [--help]
-#   (also: --cases "corridor survey")
+#   tests/benchmarks/slam/monocular.sh [--build DIR] [--out DIR] [--cases "room office fr1 desk"]
+#       [--set "KEY=VALUE; ..."] [--help]
+#   (also: --cases "corridor survey"; --set adds keygrid-slam overrides to every run, e.g.
+#   --set slam.mode=threaded)
 # Results: doc/evaluation.md, "Monocular mode".
 set -euo pipefail
 source "$(dirname "${BASH_SOURCE[0]}")/../lib/common.sh"
 out=/tmp/keygrid_monocular
 cases="room office fr1 desk"
+extra=""
 data="$root/../shared/data"
-kg_parse_args --build=build --out=out --cases=cases -- "$@"
+kg_parse_args --build=build --out=out --cases=cases --set=extra -- "$@"
 build="$(kg_build_dir "$build" keygrid-sim keygrid-slam keygrid-eval)" || exit 2
 mkdir -p "$out" || die "cannot create $out"
 
@@ -56,6 +59,7 @@ run() {
   local overrides="slam.sensor=monocular"
   [ "$height" != 0 ] && overrides="$overrides; camera_height_scale.camera_height=$height"
   [ -n "$set" ] && overrides="$overrides; $set"
+  [ -n "$extra" ] && overrides="$overrides; $extra"
   echo "== $tag: keygrid-slam -> $dir" >&2
   "$build/bin/keygrid-slam" --quiet --config "$cfg" --input "$input" --gt "$gt" --output "$dir" \
     --set "$overrides" >"$dir/slam.log" 2>&1 || { echo "| $tag | keygrid-slam failed: $dir/slam.log |"; return; }
@@ -153,7 +157,7 @@ for c in $cases; do
       run office_loop "$mono" "$d/tum" "$d/groundtruth.txt" 0 office_loop
       run office_loop_h "$mono" "$d/tum" "$d/groundtruth.txt" 1.40 office_loop ;;
     corridor|survey)
-      # Validation scenes (not tuned on): with camera_height only; threaded runs by hand.
+      # Validation scenes (not tuned on): with camera_height only (threaded: --set slam.mode=threaded).
       scene=corridor_loop; h=1.40; [ "$c" = survey ] && scene=room_survey h=1.30
       d="$(render $scene $scene)"
       run "${scene}_h" "$mono" "$d/tum" "$d/groundtruth.txt" $h $scene ;;

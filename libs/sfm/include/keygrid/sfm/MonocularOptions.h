@@ -63,6 +63,12 @@ struct MonocularOptions : public core::FieldTableOptions<MonocularOptions>
 	 * tracking has lost most of its reference's landmarks starves the map in a fast turn
 	 * (doc/frontend.md "Monocular mode"); 0 = insert whenever tracking asks (Default: 0.6) */
 	double busyKeyFrameRatio{0.6};
+	/** Threaded mode with [slam] mapping_lag > 0: replaces [slam] wait_for_weak_keyframes in
+	 * monocular mode. After a keyframe inserted while local mapping was busy (tracking below
+	 * busy_keyframe_ratio), tracking waits until local mapping is done with it: only keyframes
+	 * make landmarks, and in a fast turn frames tracked ahead of them lose their last ones
+	 * (doc/frontend.md "Modes") (Default: true) */
+	bool waitForWeakKeyFrames{true};
 	/** Reference-keyframe landmarks counted by that ratio: those seen by at least this many
 	 * keyframes, 2 while the map has two keyframes (Default: 3, ORB-SLAM2's) */
 	int keyFrameRefMinObservations{3};

@@ -77,6 +77,9 @@ struct TrackedFrame
 	int matches{0}, inliers{0};
 	bool newKeyFrame{false};
 	KeyFrameId keyframe{0};  //!< the new keyframe when newKeyFrame
+	/** Threaded mode: the new keyframe was inserted while local mapping was still busy, as
+	 * tracking fell below the deferral share (Tracker::deferKeyFramesWhile). */
+	bool keyFrameWhileMappingBusy{false};
 	/** Pose relative to the reference keyframe, so the final trajectory follows map refinements. */
 	KeyFrameId reference{0};
 	mrpt::poses::CPose3D T_ref_cam;
@@ -120,7 +123,8 @@ class Tracker
 	/** Threaded mode (ORB-SLAM2's rule): while `mappingBusy()` says local mapping is still
 	 * working on a keyframe, a new one is inserted only at the keyframe timeout or when the
 	 * frame tracks fewer than `weakRatio` x the reference keyframe's landmarks. Fewer
-	 * keyframes, each of them mapped before the next; `weakRatio` in (0, 1]. */
+	 * keyframes, each of them mapped before the next; `weakRatio` in (0, 1]. A keyframe
+	 * inserted while mapping is busy says so (TrackedFrame::keyFrameWhileMappingBusy). */
 	void deferKeyFramesWhile(std::function<bool()> mappingBusy, double weakRatio);
 
 	/** Tracks one frame whose features were extracted by the caller. In threaded mode the
@@ -229,11 +233,18 @@ class Tracker
 	double stepDuration(double timestamp) const;
 	/** HOC update and pruning after the pose of cur is final. */
 	void updateHoc(Current& cur, TrackedFrame& out);
-	bool needKeyFrame(const Current& cur) const;
+	/** Whether this frame becomes a keyframe (needKeyFrame*, insertUnlessDeferred). */
+	enum class KeyFrameNeed
+	{
+		No,
+		Yes,
+		YesWhileMappingBusy  //!< see TrackedFrame::keyFrameWhileMappingBusy
+	};
+	KeyFrameNeed needKeyFrame(const Current& cur) const;
 	/** ORB-SLAM2's monocular rule: fewer tracked landmarks than keyframe_tracked_ratio x the
 	 * reference keyframe's (seen by >= keyframe_ref_min_observations keyframes), or the
 	 * keyframe timeout; and enough inliers. */
-	bool needKeyFrameMonocular(const Current& cur) const;
+	KeyFrameNeed needKeyFrameMonocular(const Current& cur) const;
 	KeyFrameId createKeyFrame(const Current& cur);
 	/** A keyframe of the current frame: its time, pose, features, depth and colour image. */
 	static KeyFrame keyFrameOf(const Current& cur);
@@ -263,6 +274,9 @@ class Tracker
 	PlaceRecognizer m_placeRecognizer;
 	std::function<bool()> m_mappingBusy;  //!< see deferKeyFramesWhile (empty: never deferred)
 	double m_deferWeakRatio{0};  //!< set with m_mappingBusy
+	/** needKeyFrame's last step: `wanted` (a keyframe by the mode's own rule) unless local
+	 * mapping is busy and tracking not weak enough to insist (deferKeyFramesWhile). */
+	KeyFrameNeed insertUnlessDeferred(bool wanted, bool timeout, int inliers, int refMatches) const;
 	bool m_insertKeyFrames{true};  //!< see setKeyFrameInsertion
 	std::uint32_t m_newMapId{0};  //!< KeyFrame::mapId of the map initialize() starts
 	bool m_relocRecognized{false};  //!< the last relocalize() succeeded on a recognized place

@@ -117,6 +117,17 @@ struct SlamConfig
 	 * whenever tracking asks, busy or not. Monocular mode takes [monocular] busy_keyframe_ratio
 	 * instead. (Default: 0.35) */
 	double busyKeyFrameRatio{0.35};
+	/** Threaded mode with mapping_lag > 0: after a keyframe that tracking inserted while local
+	 * mapping was still busy (it fell below busy_keyframe_ratio), tracking waits until local
+	 * mapping has done every queued keyframe, as with mapping_lag 0, before the next frame:
+	 * in a fast turn the next frames then track against that keyframe's new landmarks
+	 * instead of running ahead of them. Monocular mode takes [monocular]
+	 * wait_for_weak_keyframes instead. (Default: false) */
+	bool waitForWeakKeyFrames{false};
+	/** Whether tracking waits after a keyframe inserted while local mapping was busy:
+	 * wait_for_weak_keyframes, in monocular mode [monocular] wait_for_weak_keyframes; false
+	 * when no keyframe is deferred (deferralRatio() 0). */
+	bool waitsForWeakKeyFrames() const;
 	/** The share that defers keyframes in threaded mode: busy_keyframe_ratio, in monocular
 	 * mode [monocular] busy_keyframe_ratio; 0 when no keyframe is deferred (sequential mode,
 	 * mapping_lag 0). */

@@ -257,9 +257,12 @@ class System
 	/** Loop detection and correction of a keyframe (map lock held); the event when one closed. */
 	std::optional<loop::LoopClosureEvent> closeLoops(const KeyFrameJob& job, sfm::TrackedFrame* tf);
 	void mappingThread();
-	/** Threaded mode, tracking thread: blocks until local mapping is at most [slam]
-	 * mapping_lag keyframes behind (throws if a background thread failed). */
-	void waitForMapping();
+	/** Threaded mode, tracking thread: hands a keyframe to local mapping (throws if a
+	 * background thread failed). */
+	void queueForMapping(const KeyFrameJob& job);
+	/** Threaded mode, tracking thread: blocks until local mapping is at most `lag` keyframes
+	 * behind (throws if a background thread failed). */
+	void waitForMapping(std::size_t lag);
 	void loopClosingThread();
 	void setBackgroundError(const std::string& what);
 	void throwIfBackgroundFailed() const;
