@@ -181,14 +181,14 @@ const sfm::TrackedFrame& System::processExtracted(const core::Frame& frame, sfm:
 	countFrame(tf);
 	const bool queueKeyFrame = tf.newKeyFrame && m_mappingQueue;
 	m_frames.push_back(std::move(tf));
-	const bool whileBusy = m_frames.back().keyFrameWhileMappingBusy;
 	if (queueKeyFrame && initialJob) queueForMapping(*initialJob);
 	if (queueKeyFrame)
 	{
 		queueForMapping(job);
 		// A keyframe tracking had to insert while local mapping was busy: the next frames
 		// track against its landmarks (SlamConfig::waitsForWeakKeyFrames).
-		waitForMapping(whileBusy && m_cfg.waitsForWeakKeyFrames() ? 0 : static_cast<std::size_t>(m_cfg.mappingLag));
+		const bool waitAll = m_frames.back().keyFrameWhileMappingBusy && m_cfg.waitsForWeakKeyFrames();
+		waitForMapping(waitAll ? 0 : static_cast<std::size_t>(m_cfg.mappingLag));
 	}
 	return m_frames.back();
 }
