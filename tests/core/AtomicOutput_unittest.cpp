@@ -14,9 +14,11 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
+#include "TestChecks.h"
 #include "TestData.h"
 
 using namespace keygrid::core;
+using keygrid::test::errorOf;
 
 namespace
 {
@@ -35,20 +37,6 @@ void fullDiskFor(const std::string& path)
 	std::filesystem::create_symlink("/dev/full", atomicTmpPath(path));
 }
 
-/** The message of the std::runtime_error `f` throws, or "" when it does not throw. */
-template <typename F>
-std::string errorOf(F&& f)
-{
-	try
-	{
-		f();
-	}
-	catch (const std::runtime_error& e)
-	{
-		return e.what();
-	}
-	return "";
-}
 }  // namespace
 
 TEST(AtomicOutput, TemporaryNamesKeepTheExtensionLast)
@@ -67,11 +55,11 @@ TEST(AtomicOutput, AFullDiskIsNamedAndTheOldFileIsKept)
 
 	// 20 bytes: they sit in the stream's buffer until the flush at close.
 	fullDiskFor(txt);
-	EXPECT_EQ(errorOf([&] { writeFileAtomically(txt, std::string(20, 'x')); }), "cannot write '" + txt + "': No space left on device");
+	EXPECT_EQ(errorOf<std::runtime_error>([&] { writeFileAtomically(txt, std::string(20, 'x')); }), "cannot write '" + txt + "': No space left on device");
 	// Small gzip data: zlib keeps it until gzclose().
 	fullDiskFor(gz);
 	EXPECT_EQ(
-		errorOf([&] { writeGzAtomically(gz, [](mrpt::io::CStream& s) { s.Write("abc", 3); }); }),
+		errorOf<std::runtime_error>([&] { writeGzAtomically(gz, [](mrpt::io::CStream& s) { s.Write("abc", 3); }); }),
 		"cannot write '" + gz + "': No space left on device");
 	// Large gzip data: the failure shows in a write; later writes and the commit fail too.
 	fullDiskFor(gz);
@@ -79,14 +67,14 @@ TEST(AtomicOutput, AFullDiskIsNamedAndTheOldFileIsKept)
 		AtomicGzFile f(gz);
 		std::vector<char> noise(4 << 20);
 		cv::randu(cv::Mat(1, static_cast<int>(noise.size()), CV_8UC1, noise.data()), 0, 256);
-		EXPECT_NE(errorOf([&] { f.Write(noise.data(), noise.size()); }).find("No space left on device"), std::string::npos);
-		EXPECT_NE(errorOf([&] { f.Write("a", 1); }).find("an earlier write failed"), std::string::npos);
-		EXPECT_NE(errorOf([&] { f.commit(); }).find("an earlier write failed"), std::string::npos);
+		EXPECT_NE(errorOf<std::runtime_error>([&] { f.Write(noise.data(), noise.size()); }).find("No space left on device"), std::string::npos);
+		EXPECT_NE(errorOf<std::runtime_error>([&] { f.Write("a", 1); }).find("an earlier write failed"), std::string::npos);
+		EXPECT_NE(errorOf<std::runtime_error>([&] { f.commit(); }).find("an earlier write failed"), std::string::npos);
 	}
 	// A writer that takes a file name.
 	fullDiskFor(png);
 	const cv::Mat img(64, 64, CV_8UC1, cv::Scalar(7));
-	EXPECT_NE(errorOf([&] { writeFileThrough(png, [&](const std::string& tmp) { return cv::imwrite(tmp, img); }); }), "");
+	EXPECT_NE(errorOf<std::runtime_error>([&] { writeFileThrough(png, [&](const std::string& tmp) { return cv::imwrite(tmp, img); }); }), "");
 
 	for (const auto& p : {txt, gz, png})
 	{
@@ -110,11 +98,11 @@ TEST(AtomicOutput, WritersProduceTheFileAndNothingElse)
 	ASSERT_EQ(back.size(), img.size());
 	EXPECT_EQ(cv::countNonZero(back != img), 0);
 	// A writer that fails, or writes nothing, leaves nothing.
-	EXPECT_NE(errorOf([&] { writeFileThrough(dir + "/d.png", [](const std::string&) { return false; }); }).find("'" + dir + "/d.png'"), std::string::npos);
-	EXPECT_NE(errorOf([&] { writeFileThrough(dir + "/e.png", [](const std::string&) { return true; }); }).find("produced no file"), std::string::npos);
+	EXPECT_NE(errorOf<std::runtime_error>([&] { writeFileThrough(dir + "/d.png", [](const std::string&) { return false; }); }).find("'" + dir + "/d.png'"), std::string::npos);
+	EXPECT_NE(errorOf<std::runtime_error>([&] { writeFileThrough(dir + "/e.png", [](const std::string&) { return true; }); }).find("produced no file"), std::string::npos);
 	// A folder under the name is refused.
 	std::filesystem::create_directories(dir + "/f.txt");
-	EXPECT_NE(errorOf([&] { writeFileAtomically(dir + "/f.txt", "x"); }).find("it is a folder"), std::string::npos);
+	EXPECT_NE(errorOf<std::runtime_error>([&] { writeFileAtomically(dir + "/f.txt", "x"); }).find("it is a folder"), std::string::npos);
 
 	std::vector<std::string> names;
 	for (const auto& e : std::filesystem::directory_iterator(dir)) names.push_back(e.path().filename().string());

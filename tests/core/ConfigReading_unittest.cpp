@@ -9,25 +9,10 @@
 #include <stdexcept>
 #include <string>
 
-using namespace keygrid;
+#include "TestChecks.h"
 
-namespace
-{
-/** The message of what `f` throws (std::invalid_argument expected), "" when nothing. */
-template <class F>
-std::string errorOf(F&& f)
-{
-	try
-	{
-		f();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		return e.what();
-	}
-	return "";
-}
-}  // namespace
+using namespace keygrid;
+using keygrid::test::errorOf;
 
 TEST(ConfigReading, IntegersAreWholeNumbersInTheirRange)
 {

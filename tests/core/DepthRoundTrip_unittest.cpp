@@ -5,22 +5,16 @@
 #include <keygrid/core/TumFrameSource.h>
 
 #include "SyntheticTum.h"
+#include "TestChecks.h"
 #include "TestData.h"
 
 #include <cstring>
 
 using namespace keygrid::core;
+using keygrid::test::sameBits;
 
 namespace
 {
-bool sameBits(const cv::Mat& a, const cv::Mat& b)
-{
-	if (a.size() != b.size() || a.type() != b.type()) return false;
-	for (int r = 0; r < a.rows; r++)
-		if (std::memcmp(a.ptr(r), b.ptr(r), a.cols * a.elemSize()) != 0) return false;
-	return true;
-}
-
 void roundTrip(const std::string& tumDir, const std::string& out, bool external, const FrameSourceOptions& so)
 {
 	TumFrameSource tum(tumDir, so);

@@ -12,20 +12,16 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "TestChecks.h"
 #include "TestData.h"
 
 #include <algorithm>
 
 using namespace keygrid::core;
+using keygrid::test::sameBits;
 
 namespace
 {
-/** Same size, type and pixels. */
-bool sameBits(const cv::Mat& a, const cv::Mat& b)
-{
-	return a.size() == b.size() && a.type() == b.type() && (a.empty() || cv::norm(a, b, cv::NORM_INF) == 0);
-}
-
 cv::Mat randomImage(int w, int h, int type, unsigned seed)
 {
 	cv::Mat m(h, w, type);

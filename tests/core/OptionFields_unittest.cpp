@@ -9,29 +9,18 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
-#include <functional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "TestChecks.h"
+
 using namespace keygrid;
+using keygrid::test::errorOf;
 
 namespace
 {
-std::string errorOf(const std::function<void()>& f)
-{
-	try
-	{
-		f();
-	}
-	catch (const std::invalid_argument& e)
-	{
-		return e.what();
-	}
-	return "";
-}
-
 /** A struct of every field type, with a custom (list) field. */
 struct Options
 {

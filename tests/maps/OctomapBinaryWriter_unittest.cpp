@@ -14,10 +14,10 @@
 namespace
 {
 using keygrid::maps::OctomapBinaryWriter;
-using Voxel = std::tuple<int, int, int, bool>;
+using OctreeVoxel = std::tuple<int, int, int, bool>;
 
 /** What OctoMap writes for the voxels (set in this order at full depth). */
-std::string octomapBytes(const std::vector<Voxel>& voxels, double res, const std::string& comment)
+std::string octomapBytes(const std::vector<OctreeVoxel>& voxels, double res, const std::string& comment)
 {
 	octomap::OcTree tree(res);
 	for (const auto& [x, y, z, occ] : voxels)
@@ -38,7 +38,7 @@ std::string octomapBytes(const std::vector<Voxel>& voxels, double res, const std
 	return s.str();
 }
 
-std::string writerBytes(const std::vector<Voxel>& voxels, double res, const std::string& comment)
+std::string writerBytes(const std::vector<OctreeVoxel>& voxels, double res, const std::string& comment)
 {
 	OctomapBinaryWriter w;
 	for (const auto& [x, y, z, occ] : voxels) EXPECT_TRUE(w.add(x, y, z, occ));
@@ -49,11 +49,11 @@ std::string writerBytes(const std::vector<Voxel>& voxels, double res, const std:
 
 /** Whole cubes of one state (pruned at several levels), cubes with one voxel flipped or
  * missing (not pruned), scattered voxels on both sides of zero, and repeated voxels. */
-std::vector<Voxel> mixedScene(unsigned seed)
+std::vector<OctreeVoxel> mixedScene(unsigned seed)
 {
 	std::mt19937 rng(seed);
 	std::uniform_int_distribution<int> pos(-40, 40), coin(0, 1), sizeLog(1, 3);
-	std::vector<Voxel> v;
+	std::vector<OctreeVoxel> v;
 	for (int c = 0; c < 12; c++)
 	{
 		const int n = 1 << sizeLog(rng);
@@ -95,7 +95,7 @@ TEST(OctomapBinaryWriter, KeysAroundTheOriginAndAtTheRangeEdges)
 {
 	// The 2x2x2 block around the origin lies in the root's eight children, one voxel each
 	// (keys 32767 and 32768 differ in their top bit): eight paths of single children.
-	std::vector<Voxel> v;
+	std::vector<OctreeVoxel> v;
 	for (int z = -1; z <= 0; z++)
 		for (int y = -1; y <= 0; y++)
 			for (int x = -1; x <= 0; x++) v.emplace_back(x, y, z, false);
@@ -103,7 +103,7 @@ TEST(OctomapBinaryWriter, KeysAroundTheOriginAndAtTheRangeEdges)
 	v.emplace_back(32767, -32768, -32768, false);
 	EXPECT_EQ(writerBytes(v, 0.1, ""), octomapBytes(v, 0.1, ""));
 	// One aligned 2x2x2 block of free voxels: collapses into one leaf.
-	std::vector<Voxel> octant(v.begin(), v.begin() + 8);
+	std::vector<OctreeVoxel> octant(v.begin(), v.begin() + 8);
 	for (auto& [x, y, z, occ] : octant) x += 2, y += 2, z += 2;
 	EXPECT_EQ(writerBytes(octant, 0.1, ""), octomapBytes(octant, 0.1, ""));
 	EXPECT_EQ(writerBytes({}, 0.1, ""), octomapBytes({}, 0.1, ""));

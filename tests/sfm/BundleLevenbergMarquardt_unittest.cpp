@@ -13,6 +13,8 @@
 
 using namespace keygrid::sfm;
 
+namespace bundle_levenberg_marquardt_unittest
+{
 namespace
 {
 const PinholeIntrinsics K{517.3, 516.5, 318.6, 255.3};
@@ -315,3 +317,4 @@ TEST(BundleLevenbergMarquardt, AGlobalAdjustmentOfALongMapMatchesCeresSparseSchu
 	}
 	for (const auto& [id, lm] : dedicated.landmarks()) EXPECT_LT((lm.p_world - ceresMap.landmark(id).p_world).norm(), 1e-6) << "landmark " << id;
 }
+}  // namespace bundle_levenberg_marquardt_unittest

@@ -24,6 +24,8 @@
 using namespace keygrid;
 using mrpt::poses::CPose3D;
 
+namespace camera_height_scale_scene_unittest
+{
 namespace
 {
 /** Depth std of a map point [m]: z^2 sigma_px / (f B) for 1 px of keypoint noise at the
@@ -141,3 +143,4 @@ TEST_P(CameraHeightScaleScene, RecoversTheMetricScaleFromTheCameraHeight)
 INSTANTIATE_TEST_SUITE_P(
 	SimScenes, CameraHeightScaleScene, ::testing::Values(SceneCase{"room_loop.ini", 15}, SceneCase{"office_loop.ini", 50}),
 	[](const ::testing::TestParamInfo<SceneCase>& info) { return std::string(info.param.file).substr(0, std::string(info.param.file).find('.')); });
+}  // namespace camera_height_scale_scene_unittest

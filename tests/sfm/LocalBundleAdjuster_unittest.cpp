@@ -11,6 +11,8 @@
 using namespace keygrid::sfm;
 using mrpt::poses::CPose3D;
 
+namespace local_bundle_adjuster_unittest
+{
 namespace
 {
 const PinholeIntrinsics K{517.3, 516.5, 318.6, 255.3};
@@ -429,3 +431,4 @@ TEST(LocalMapper, PhasesGiveTheResultOfProcessAndDropASolveAcrossACorrection)
 	EXPECT_EQ(repDropped.ba.observations, 0);
 	EXPECT_TRUE(corrected.map.keyframe(3).T_world_cam == before);
 }
+}  // namespace local_bundle_adjuster_unittest

@@ -7,6 +7,8 @@
 using namespace keygrid::sfm;
 using namespace keygrid::sfm::test;
 
+namespace pose_levenberg_marquardt_unittest
+{
 namespace
 {
 PoseSolverOptions tight()
@@ -97,3 +99,4 @@ TEST(PoseLevenbergMarquardt, APointBehindTheCameraAtTheStartLeavesThePoseAlone)
 	EXPECT_EQ(R, R0);
 	EXPECT_EQ(t, t0);
 }
+}  // namespace pose_levenberg_marquardt_unittest

@@ -1,6 +1,7 @@
 // Pose-only refinement and PnP on synthetic correspondences with a known pose.
 #include <keygrid/sfm/PnpSolver.h>
 #include <keygrid/sfm/PoseOptimizer.h>
+#include <keygrid/sfm/Triangulation.h>
 
 #include <ceres/ceres.h>
 #include <cmath>
@@ -11,6 +12,8 @@
 using namespace keygrid::sfm;
 using mrpt::poses::CPose3D;
 
+namespace pose_optimizer_unittest
+{
 namespace
 {
 const PinholeIntrinsics K{517.3, 516.5, 318.6, 255.3};
@@ -245,8 +248,6 @@ TEST(RgbdReprojectionCost, AutoDiffJacobianMatchesFiniteDifferences)
 	delete nd;
 }
 
-#include <keygrid/sfm/Triangulation.h>
-
 TEST(Triangulation, DltRecoversAPointFromTwoViews)
 {
 	const CPose3D T1(0, 0, 0, 0, 0, 0), T2(0.3, 0.05, -0.02, 0.1, -0.05, 0.02);
@@ -264,3 +265,4 @@ TEST(Triangulation, DltRecoversAPointFromTwoViews)
 	const CPose3D Tright(0.3, 0, 0, 0, 0, 0);
 	EXPECT_FALSE(triangulateDlt(T1, Eigen::Vector2d(K.cx + 50, K.cy), Tright, Eigen::Vector2d(K.cx + 100, K.cy), K, est));
 }
+}  // namespace pose_optimizer_unittest

@@ -15,6 +15,8 @@
 using namespace keygrid;
 using mrpt::poses::CPose3D;
 
+namespace tracker_monocular_unittest
+{
 namespace
 {
 constexpr int kWorldPoints = 600;
@@ -253,3 +255,4 @@ TEST(TrackerMonocular, AWallInViewIsResolvedByThePlaneAndStartsTheTrueMap)
 		ASSERT_TRUE(startFrame.has_value());
 	}
 }
+}  // namespace tracker_monocular_unittest

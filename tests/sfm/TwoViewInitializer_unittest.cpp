@@ -20,6 +20,8 @@
 
 using namespace keygrid::sfm;
 
+namespace two_view_initializer_unittest
+{
 namespace
 {
 constexpr double kW = 640, kH = 480, kSigma = 1.0;
@@ -504,3 +506,4 @@ TEST(TwoViewInitializer, ARotationLikeSecondSolutionOfAPlaneIsNoRivalForSideways
 		EXPECT_LT(a.candidates[1].parallaxDeg, strict.minParallaxDeg);
 	}
 }
+}  // namespace two_view_initializer_unittest

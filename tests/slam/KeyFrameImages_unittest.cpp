@@ -17,23 +17,16 @@
 #include <limits>
 #include <random>
 
+#include "TestChecks.h"
 #include "TestData.h"
 
 using namespace keygrid;
 using namespace keygrid::slam;
+using keygrid::test::sameBits;
 
 namespace
 {
 constexpr float kDepthUnits = 0.0002f;
-
-bool sameBits(const cv::Mat& a, const cv::Mat& b)
-{
-	if (a.empty() || b.empty()) return a.empty() && b.empty();
-	if (a.size() != b.size() || a.type() != b.type()) return false;
-	for (int r = 0; r < a.rows; r++)
-		if (std::memcmp(a.ptr(r), b.ptr(r), a.cols * a.elemSize()) != 0) return false;
-	return true;
-}
 
 /** Depth in metres as sensors give it (a multiple of the depth units, some holes), seeded. */
 cv::Mat depthImage(int seed, int rows = 48, int cols = 64)

@@ -17,6 +17,8 @@
 using namespace keygrid;
 using mrpt::poses::CPose3D;
 
+namespace monocular_maps_unittest
+{
 namespace
 {
 constexpr double kHeightMap = 0.5;  // camera height in map units
@@ -181,3 +183,4 @@ TEST(MonocularMaps, RescaleRefusesABadFactorAndFloorSourceIsSetBeforeKeyFrames)
 	late.insertKeyFrame(map, addKeyFrame(map, 0), 0.0);
 	EXPECT_THROW(late.useFloorFromCameraHeight(), std::logic_error);
 }
+}  // namespace monocular_maps_unittest

@@ -19,6 +19,8 @@
 using namespace keygrid;
 using namespace keygrid::slam;
 
+namespace simple_map_export_unittest
+{
 namespace
 {
 std::vector<char> fileBytes(const std::string& path)
@@ -105,3 +107,4 @@ TEST(SimpleMapExport, EmptyMapStreamsAnEmptySimpleMap)
 	core::saveGzAtomically(mrpt::maps::CSimpleMap(), dir + "/b.simplemap");
 	EXPECT_TRUE(fileBytes(dir + "/a.simplemap") == fileBytes(dir + "/b.simplemap"));
 }
+}  // namespace simple_map_export_unittest

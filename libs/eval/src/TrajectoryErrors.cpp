@@ -1,3 +1,4 @@
+#include <keygrid/core/JsonNumber.h>
 #include <keygrid/core/TimestampAssociation.h>
 #include <keygrid/eval/TrajectoryErrors.h>
 #include <mrpt/core/bits_math.h>
@@ -159,36 +160,25 @@ TrajectoryErrors evaluateTrajectory(
 	return out;
 }
 
-namespace
-{
-std::string num(double v)
-{
-	if (!std::isfinite(v)) return "null";
-	char b[64];
-	std::snprintf(b, sizeof(b), "%.9g", v);
-	return b;
-}
-}  // namespace
-
 std::string TrajectoryErrors::toJson() const
 {
 	std::ostringstream o;
 	o << "{\n";
-	o << "  \"ate_rmse_m\": " << num(ate.rmse) << ",\n";
-	o << "  \"ate_mean_m\": " << num(ate.mean) << ",\n";
-	o << "  \"ate_median_m\": " << num(ate.median) << ",\n";
-	o << "  \"ate_std_m\": " << num(ate.stddev) << ",\n";
-	o << "  \"ate_min_m\": " << num(ate.min) << ",\n";
-	o << "  \"ate_max_m\": " << num(ate.max) << ",\n";
-	o << "  \"ate_rot_rmse_deg\": " << num(ateRotDeg.rmse) << ",\n";
-	o << "  \"rpe_trans_m_per_s\": " << (rpeTrans ? num(rpeTrans->rmse) : "null") << ",\n";
-	o << "  \"rpe_rot_deg_per_s\": " << (rpeRotDeg ? num(rpeRotDeg->rmse) : "null") << ",\n";
+	o << "  \"ate_rmse_m\": " << core::jsonNumber(ate.rmse) << ",\n";
+	o << "  \"ate_mean_m\": " << core::jsonNumber(ate.mean) << ",\n";
+	o << "  \"ate_median_m\": " << core::jsonNumber(ate.median) << ",\n";
+	o << "  \"ate_std_m\": " << core::jsonNumber(ate.stddev) << ",\n";
+	o << "  \"ate_min_m\": " << core::jsonNumber(ate.min) << ",\n";
+	o << "  \"ate_max_m\": " << core::jsonNumber(ate.max) << ",\n";
+	o << "  \"ate_rot_rmse_deg\": " << core::jsonNumber(ateRotDeg.rmse) << ",\n";
+	o << "  \"rpe_trans_m_per_s\": " << (rpeTrans ? core::jsonNumber(rpeTrans->rmse) : "null") << ",\n";
+	o << "  \"rpe_rot_deg_per_s\": " << (rpeRotDeg ? core::jsonNumber(rpeRotDeg->rmse) : "null") << ",\n";
 	o << "  \"rpe_pairs\": " << (rpeTrans ? rpeTrans->count : 0) << ",\n";
-	o << "  \"rpe_delta_s\": " << num(rpeDelta) << ",\n";
+	o << "  \"rpe_delta_s\": " << core::jsonNumber(rpeDelta) << ",\n";
 	o << "  \"matched\": " << matched << ",\n";
 	o << "  \"gt_poses\": " << gtPoses << ",\n";
 	o << "  \"est_poses\": " << estPoses << ",\n";
-	o << "  \"alignment_scale\": " << num(alignment.s) << "\n";
+	o << "  \"alignment_scale\": " << core::jsonNumber(alignment.s) << "\n";
 	o << "}\n";
 	return o.str();
 }

@@ -1,3 +1,4 @@
+#include <keygrid/core/JsonNumber.h>
 #include <keygrid/eval/VoxelMapMetrics.h>
 
 #include <cmath>
@@ -41,12 +42,6 @@ VoxelIndex plus(const VoxelIndex& a, const VoxelIndex& b) { return {a[0] + b[0],
 
 double ratio(std::size_t a, std::size_t b) { return b ? double(a) / double(b) : 0.0; }
 
-std::string num(double v)
-{
-	char b[64];
-	std::snprintf(b, sizeof(b), "%.6g", v);
-	return b;
-}
 }  // namespace
 
 VoxelTruth::VoxelTruth(double resolution, const Eigen::Vector3d& origin, const std::vector<VoxelIndex>& occupied)
@@ -196,11 +191,11 @@ std::string VoxelMapMetrics::jsonFields(const std::string& prefix) const
 	field("occupied_voxels", std::to_string(estOccupied));
 	field("occupied_matched", std::to_string(estOccupiedMatched));
 	field("free_voxels", std::to_string(estFree));
-	field("precision", num(precision));
+	field("precision", core::jsonNumber(precision, 6));
 	field("true_voxels", std::to_string(gtOccupied));
-	field("recall", num(recall));
+	field("recall", core::jsonNumber(recall, 6));
 	field("true_voxels_seen", std::to_string(gtSeen));
-	field("recall_seen", num(seenRecall));
+	field("recall_seen", core::jsonNumber(seenRecall, 6));
 	field("true_called_free", std::to_string(gtCalledFree));
 	field("hazard_voxels", std::to_string(hazardVoxels), true);
 	return o.str();

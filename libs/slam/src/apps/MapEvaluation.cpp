@@ -1,3 +1,4 @@
+#include <keygrid/core/JsonNumber.h>
 #include <keygrid/sim/GroundTruthOccupancy.h>
 #include <keygrid/sim/SequenceWriter.h>
 #include <keygrid/slam/apps/KeyFrameViews.h>
@@ -43,12 +44,6 @@ std::size_t markVisibility(maps::FloorPlanGrid& gt, const MapEvaluationOptions& 
 	});
 }
 
-std::string num(double v)
-{
-	char b[64];
-	std::snprintf(b, sizeof(b), "%.6g", v);
-	return b;
-}
 }  // namespace
 
 MapEvaluationResult evaluateMapAgainstFloorPlan(
@@ -127,19 +122,19 @@ std::string MapEvaluationResult::jsonFields() const
 	o << "  \"map_hazard_cells\": " << m.hazardCells << ",\n"
 	  << "  \"map_interior_obstacle_cells\": " << m.gtOccupiedInterior << ",\n"
 	  << "  \"map_obstacle_called_free_cells\": " << m.gtOccupiedCalledFree << ",\n"
-	  << "  \"map_boundary_recall\": " << num(m.boundaryRecall) << ",\n"
+	  << "  \"map_boundary_recall\": " << core::jsonNumber(m.boundaryRecall, 6) << ",\n"
 	  << "  \"map_boundary_cells_seen\": " << m.gtBoundarySeen << ",\n"
-	  << "  \"map_obstacle_precision\": " << num(m.precision) << ",\n"
-	  << "  \"map_obstacle_recall\": " << num(m.recall) << ",\n"
-	  << "  \"map_free_precision\": " << num(m.freePrecision) << ",\n"
-	  << "  \"map_free_recall\": " << num(m.freeRecall) << ",\n"
-	  << "  \"map_free_f1\": " << num(m.freeF1) << ",\n"
+	  << "  \"map_obstacle_precision\": " << core::jsonNumber(m.precision, 6) << ",\n"
+	  << "  \"map_obstacle_recall\": " << core::jsonNumber(m.recall, 6) << ",\n"
+	  << "  \"map_free_precision\": " << core::jsonNumber(m.freePrecision, 6) << ",\n"
+	  << "  \"map_free_recall\": " << core::jsonNumber(m.freeRecall, 6) << ",\n"
+	  << "  \"map_free_f1\": " << core::jsonNumber(m.freeF1, 6) << ",\n"
 	  << "  \"map_free_cells_seen\": " << m.gtFreeSeen << ",\n"
-	  << "  \"map_free_recall_floor_seen\": " << num(m.freeRecallFloorSeen) << ",\n"
-	  << "  \"map_free_f1_floor_seen\": " << num(m.freeF1FloorSeen) << ",\n"
+	  << "  \"map_free_recall_floor_seen\": " << core::jsonNumber(m.freeRecallFloorSeen, 6) << ",\n"
+	  << "  \"map_free_f1_floor_seen\": " << core::jsonNumber(m.freeF1FloorSeen, 6) << ",\n"
 	  << "  \"map_free_cells_floor_seen\": " << m.gtFreeFloorSeen << ",\n"
-	  << "  \"map_floor_offset_m\": " << num(floorOffset) << ",\n"
-	  << "  \"map_floor_tilt_deg\": " << num(floorTiltDeg) << ",\n"
+	  << "  \"map_floor_offset_m\": " << core::jsonNumber(floorOffset, 6) << ",\n"
+	  << "  \"map_floor_tilt_deg\": " << core::jsonNumber(floorTiltDeg, 6) << ",\n"
 	  << "  \"map_visibility_keyframes\": " << visibilityKeyframes;
 	return o.str();
 }
