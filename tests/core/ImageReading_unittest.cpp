@@ -5,6 +5,7 @@
 #include <libdeflate.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "TestChecks.h"
 #include "TestData.h"
 
 #include <cstdio>
@@ -12,15 +13,10 @@
 #include <random>
 
 using namespace keygrid;
+using keygrid::test::sameBits;
 
 namespace
 {
-bool sameImage(const cv::Mat& a, const cv::Mat& b)
-{
-	if (a.empty() || b.empty()) return a.empty() && b.empty();
-	return a.type() == b.type() && a.size() == b.size() && cv::norm(a, b, cv::NORM_INF) == 0;
-}
-
 /** Noise over gradients: libpng's adaptive filtering then picks different filters per row. */
 cv::Mat testImage(int rows, int cols, int type, unsigned seed)
 {
@@ -128,7 +124,7 @@ TEST(ImageReading, PngsWrittenByOpenCvReadAsImreadReadsThem)
 											{cv::IMWRITE_PNG_COMPRESSION, level, cv::IMWRITE_PNG_STRATEGY, strategy}));
 					for (int flags : {cv::IMREAD_COLOR, cv::IMREAD_ANYDEPTH})
 					{
-						EXPECT_TRUE(sameImage(core::readImage(path, flags), cv::imread(path, flags)))
+						EXPECT_TRUE(sameBits(core::readImage(path, flags), cv::imread(path, flags)))
 							<< "type " << type << " size " << size << " level " << level << " flags " << flags;
 						cv::Mat m;
 						fast += core::decodePngFast(fileBytes(path), flags, m);
@@ -157,7 +153,7 @@ TEST(ImageReading, EveryRowFilterIsUndone)
 		cv::Mat fast;
 		ASSERT_TRUE(core::decodePngFast(png, k.flags, fast)) << "bit depth " << k.bitDepth << " colour type " << k.colourType;
 		writeBytes(dir + "/f.png", png);
-		EXPECT_TRUE(sameImage(fast, cv::imread(dir + "/f.png", k.flags))) << "colour type " << k.colourType;
+		EXPECT_TRUE(sameBits(fast, cv::imread(dir + "/f.png", k.flags))) << "colour type " << k.colourType;
 		// And against the pixels themselves (the first channel of the first and last pixel).
 		const std::size_t last = pixels.size() - k.bpp;
 		if (k.bitDepth == 16)
@@ -183,7 +179,7 @@ TEST(ImageReading, DamagedAndUnsupportedFilesGoToImread)
 		EXPECT_FALSE(core::decodePngFast(bytes, cv::IMREAD_COLOR, out)) << what;
 		EXPECT_TRUE(out.empty()) << what;
 		writeBytes(dir + "/d.png", bytes);
-		EXPECT_TRUE(sameImage(core::readImage(dir + "/d.png", cv::IMREAD_COLOR), cv::imread(dir + "/d.png", cv::IMREAD_COLOR))) << what;
+		EXPECT_TRUE(sameBits(core::readImage(dir + "/d.png", cv::IMREAD_COLOR), cv::imread(dir + "/d.png", cv::IMREAD_COLOR))) << what;
 	};
 	for (std::size_t cut : {std::size_t{4}, std::size_t{20}, good.size() / 2, good.size() - 13, good.size() - 1})
 		declined({good.begin(), good.begin() + static_cast<std::ptrdiff_t>(cut)}, "truncated at " + std::to_string(cut));
@@ -213,8 +209,8 @@ TEST(ImageReading, RealTumImagesReadAsImreadReadsThem)
 		cv::Mat c, z;
 		ASSERT_TRUE(core::decodePngFast(fileBytes(d + rgb), cv::IMREAD_COLOR, c)) << rgb;
 		ASSERT_TRUE(core::decodePngFast(fileBytes(d + depth), cv::IMREAD_ANYDEPTH, z)) << depth;
-		EXPECT_TRUE(sameImage(c, cv::imread(d + rgb, cv::IMREAD_COLOR))) << rgb;
-		EXPECT_TRUE(sameImage(z, cv::imread(d + depth, cv::IMREAD_ANYDEPTH))) << depth;
+		EXPECT_TRUE(sameBits(c, cv::imread(d + rgb, cv::IMREAD_COLOR))) << rgb;
+		EXPECT_TRUE(sameBits(z, cv::imread(d + depth, cv::IMREAD_ANYDEPTH))) << depth;
 		checked++;
 	}
 	EXPECT_EQ(checked, 20);

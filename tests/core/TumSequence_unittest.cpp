@@ -2,6 +2,7 @@
 #include <keygrid/core/TumFrameSource.h>
 
 #include "SyntheticTum.h"
+#include "TestChecks.h"
 #include "TestData.h"
 
 #include <cstdio>
@@ -10,24 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 using namespace keygrid::core;
-
-namespace
-{
-/** The message of the std::runtime_error `f` throws ("" when it throws none). */
-template <typename F>
-std::string runtimeErrorOf(F f)
-{
-	try
-	{
-		f();
-	}
-	catch (const std::runtime_error& e)
-	{
-		return e.what();
-	}
-	return {};
-}
-}  // namespace
+using keygrid::test::errorOf;
 
 TEST(TimestampAssociation, NearestUniqueWithinTolerance)
 {
@@ -221,7 +205,7 @@ TEST(TumSequence, DepthIgnoredReadsTheColourImagesAloneWithoutOpeningDepth)
 	}
 	// No list of colour images: an error naming the folder.
 	std::remove((s.dir + "/associations.txt").c_str());
-	const std::string noList = runtimeErrorOf([&] { TumFrameSource b(s.dir, mono); });
+	const std::string noList = errorOf<std::runtime_error>([&] { TumFrameSource b(s.dir, mono); });
 	EXPECT_NE(noList.find("'" + s.dir + "' has neither rgb.txt nor associations.txt"), std::string::npos) << noList;
 }
 
@@ -245,17 +229,17 @@ TEST(TumSequence, FolderWithoutDepthIsAnImageOnlyInput)
 	EXPECT_FALSE(f.hasDepth());
 	// Asked for depth: an error naming the folder and what is missing.
 	o.depth = DepthUse::Use;
-	const std::string noDepth = runtimeErrorOf([&] { TumFrameSource rgbd(s.dir, o); });
+	const std::string noDepth = errorOf<std::runtime_error>([&] { TumFrameSource rgbd(s.dir, o); });
 	EXPECT_NE(noDepth.find("'" + s.dir + "' has neither associations.txt nor depth.txt"), std::string::npos) << noDepth;
 	// A missing colour image names the file, as in RGB-D mode.
 	std::remove(TumSequence(s.dir, 0.02, DepthUse::Ignore).pairs()[1].rgbPath.c_str());
 	o.depth = DepthUse::Ignore;
 	TumFrameSource gap(s.dir, o);
 	ASSERT_TRUE(gap.next(f));
-	const std::string missing = runtimeErrorOf([&] { gap.next(f); });
+	const std::string missing = errorOf<std::runtime_error>([&] { gap.next(f); });
 	EXPECT_NE(missing.find("missing image '" + s.dir + "/rgb/"), std::string::npos) << missing;
 	// An empty rgb.txt gives no image: an error naming the folder.
 	std::ofstream(s.dir + "/rgb.txt") << "# nothing\n";
-	const std::string none = runtimeErrorOf([&] { TumSequence(s.dir, 0.02, DepthUse::Ignore); });
+	const std::string none = errorOf<std::runtime_error>([&] { TumSequence(s.dir, 0.02, DepthUse::Ignore); });
 	EXPECT_NE(none.find("'" + s.dir + "': rgb.txt gives no colour image"), std::string::npos) << none;
 }

@@ -51,7 +51,7 @@ void expectSameMap(const sfm::SparseMap& a, const sfm::SparseMap& b)
 		EXPECT_EQ(la.visibleCount, lb.visibleCount);
 		EXPECT_EQ(la.foundCount, lb.foundCount);
 		EXPECT_EQ(la.hoc.counts(), lb.hoc.counts());
-		EXPECT_TRUE(test::sameMat(la.descriptor, lb.descriptor));
+		EXPECT_TRUE(test::sameBits(la.descriptor, lb.descriptor));
 	}
 }
 
@@ -114,7 +114,7 @@ TEST(SessionRecorder, TheFileFollowsTheMapThroughEveryKindOfChange)
 		EXPECT_EQ(r.landmarks, map.keyframe(r.id).landmarks) << "the stored association of keyframe " << r.id << " was kept up to date";
 	EXPECT_EQ(store.counts().keyframesWithImages, 2u);
 	const auto img = store.loadImages(2);
-	EXPECT_TRUE(test::sameMat(img.colour, map.keyframe(2).colour));
+	EXPECT_TRUE(test::sameBits(img.colour, map.keyframe(2).colour));
 	EXPECT_EQ(rec.stats().updates, 2u);
 	EXPECT_THROW(slam::SessionRecorder(path, opts), std::runtime_error) << "an existing file is not overwritten";
 }

@@ -24,8 +24,8 @@ TEST(KeyFrameImageCodec, PngRoundTripIsExact)
 		EXPECT_EQ(enc.colourFormat, "png");
 		EXPECT_LT(enc.depth.size(), depth.total() * 2) << "depth PNG compresses";
 		const auto dec = KeyFrameImageCodec::decode(enc);
-		EXPECT_TRUE(test::sameMat(dec.colour, img));
-		EXPECT_TRUE(test::sameMat(dec.depthRaw, depth));
+		EXPECT_TRUE(test::sameBits(dec.colour, img));
+		EXPECT_TRUE(test::sameBits(dec.depthRaw, depth));
 	}
 	const auto none = KeyFrameImageCodec::decode(codec.encode(cv::Mat(), cv::Mat()));
 	EXPECT_TRUE(none.colour.empty());
@@ -38,8 +38,8 @@ TEST(KeyFrameImageCodec, DepthMetresToRawIsExactForRawDepths)
 	const cv::Mat raw = test::syntheticDepthRaw(5);
 	// The frame sources compute metres as raw * units in float (core::depthRawToMetres).
 	const cv::Mat metres = core::depthRawToMetres(raw, units);
-	EXPECT_TRUE(test::sameMat(KeyFrameImageCodec::depthToRaw(metres, units), raw));
-	EXPECT_TRUE(test::sameMat(KeyFrameImageCodec::rawToDepth(raw, units), metres));
+	EXPECT_TRUE(test::sameBits(KeyFrameImageCodec::depthToRaw(metres, units), raw));
+	EXPECT_TRUE(test::sameBits(KeyFrameImageCodec::rawToDepth(raw, units), metres));
 	cv::Mat odd(1, 4, CV_32F);
 	odd.at<float>(0) = std::numeric_limits<float>::quiet_NaN();
 	odd.at<float>(1) = -1.f;

@@ -20,7 +20,7 @@ using namespace keygrid;
 using namespace keygrid::store;
 using keygrid::test::expectSameKeyFrame;
 using keygrid::test::expectSameLandmark;
-using keygrid::test::sameMat;
+using keygrid::test::sameBits;
 
 namespace
 {
@@ -126,8 +126,8 @@ TEST(SessionStore, RoundTripOfEveryRecord)
 	for (KeyFrameId id = 0; id < 3; id++)
 	{
 		const auto img = store.loadImages(id);
-		EXPECT_TRUE(sameMat(img.colour, images[id].colour)) << "keyframe " << id;
-		EXPECT_TRUE(sameMat(img.depthRaw, images[id].depthRaw)) << "keyframe " << id;
+		EXPECT_TRUE(sameBits(img.colour, images[id].colour)) << "keyframe " << id;
+		EXPECT_TRUE(sameBits(img.depthRaw, images[id].depthRaw)) << "keyframe " << id;
 	}
 	EXPECT_EQ(store.loadImages(0).colour.type(), CV_8UC3);
 	EXPECT_EQ(store.loadImages(1).colour.type(), CV_8UC1);

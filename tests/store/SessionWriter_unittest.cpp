@@ -55,8 +55,8 @@ TEST(SessionWriter, CommitsEveryUpdateWithItsImagesInOrder)
 		{
 			test::expectSameKeyFrame(test::syntheticKeyFrame(id, 200), kfs[id]);
 			const auto img = store.loadImages(id);
-			EXPECT_TRUE(test::sameMat(img.colour, test::syntheticImage(id, id % 2 == 0))) << id;
-			EXPECT_TRUE(test::sameMat(img.depthRaw, test::syntheticDepthRaw(id))) << id;
+			EXPECT_TRUE(test::sameBits(img.colour, test::syntheticImage(id, id % 2 == 0))) << id;
+			EXPECT_TRUE(test::sameBits(img.depthRaw, test::syntheticDepthRaw(id))) << id;
 		}
 		EXPECT_EQ(store.loadLandmarks().size(), 8u);
 		EXPECT_EQ(store.loadCovisibility().size(), 7u);

@@ -72,8 +72,8 @@ TEST(SparseMapRecords, KeyFramesAndLandmarksThroughTheStore)
 			  kf.features.featuresInArea(rec.undistorted[5].x, rec.undistorted[5].y, 1.0f).size())
 		<< "the lookup grid is rebuilt";
 	const auto img = store.loadImages(12);
-	EXPECT_TRUE(test::sameMat(img.colour, kf.colour));
-	EXPECT_TRUE(test::sameMat(KeyFrameImageCodec::rawToDepth(img.depthRaw, rec.camera.depthUnits), kf.depth));
+	EXPECT_TRUE(test::sameBits(img.colour, kf.colour));
+	EXPECT_TRUE(test::sameBits(KeyFrameImageCodec::rawToDepth(img.depthRaw, rec.camera.depthUnits), kf.depth));
 
 	const auto lms = store.loadLandmarks();
 	ASSERT_EQ(lms.size(), 1u);
@@ -82,7 +82,7 @@ TEST(SparseMapRecords, KeyFramesAndLandmarksThroughTheStore)
 	EXPECT_EQ(lmBack.observations, lm.observations);
 	EXPECT_EQ(lmBack.hoc.counts(), lm.hoc.counts());
 	EXPECT_EQ(lmBack.hoc.count(7), lms[0].hocCounts[7]);
-	EXPECT_TRUE(test::sameMat(lmBack.descriptor, lm.descriptor));
+	EXPECT_TRUE(test::sameBits(lmBack.descriptor, lm.descriptor));
 
 	test::expectSameCovisibility(store.loadCovisibility(), {{3, 12, 40}, {12, 20, 17}});
 }

@@ -5,15 +5,10 @@
 #include <gtest/gtest.h>
 #include <keygrid/store/SessionRecords.h>
 
+#include "TestChecks.h"
+
 namespace keygrid::test
 {
-inline bool sameMat(const cv::Mat& a, const cv::Mat& b)
-{
-	if (a.empty() || b.empty()) return a.empty() && b.empty();
-	if (a.type() != b.type() || a.size() != b.size()) return false;
-	return cv::norm(a, b, cv::NORM_INF) == 0;
-}
-
 inline void expectSamePose(const mrpt::poses::CPose3D& a, const mrpt::poses::CPose3D& b)
 {
 	for (int r = 0; r < 3; r++)
@@ -56,7 +51,7 @@ inline void expectSameKeyFrame(const store::KeyFrameRecord& a, const store::KeyF
 	}
 	EXPECT_EQ(a.undistorted, b.undistorted);
 	EXPECT_EQ(a.keypointDepth, b.keypointDepth);
-	EXPECT_TRUE(sameMat(a.descriptors, b.descriptors));
+	EXPECT_TRUE(sameBits(a.descriptors, b.descriptors));
 	EXPECT_EQ(a.levelScale, b.levelScale);
 	EXPECT_EQ(a.numLevels, b.numLevels);
 	EXPECT_EQ(a.landmarks, b.landmarks);
@@ -74,7 +69,7 @@ inline void expectSameLandmark(const store::LandmarkRecord& a, const store::Land
 	EXPECT_EQ(a.id, b.id);
 	EXPECT_EQ(a.p_world, b.p_world);
 	EXPECT_EQ(a.normal, b.normal);
-	EXPECT_TRUE(sameMat(a.descriptor, b.descriptor));
+	EXPECT_TRUE(sameBits(a.descriptor, b.descriptor));
 	EXPECT_EQ(a.observations, b.observations);
 	EXPECT_EQ(a.minDistance, b.minDistance);
 	EXPECT_EQ(a.maxDistance, b.maxDistance);
