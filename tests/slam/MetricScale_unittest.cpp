@@ -366,7 +366,10 @@ TEST(MetricScale, AfterTheFirstEstimateTheNewestStretchOfThePathIsMeasuredAndRes
 		for (const auto& [id, T] : before)
 		{
 			const auto& now = map.keyframe(id).T_world_cam;
-			if (id <= ids[kMetric + kDrifted - 11]) EXPECT_NEAR((now.asVectorVal() - T.asVectorVal()).norm(), 0.0, 1e-12) << id;
+			if (id <= ids[kMetric + kDrifted - 11])
+			{
+				EXPECT_NEAR((now.asVectorVal() - T.asVectorVal()).norm(), 0.0, 1e-12) << id;
+			}
 			EXPECT_NEAR(now.z(), kCameraHeight, 1e-9) << id;
 		}
 		// From the window's middle on, steps and floor are metric: the newest keyframe's floor

@@ -3,6 +3,9 @@
 #include <keygrid/maps/FloorFrameEstimator.h>
 #include <keygrid/sfm/CameraHeightScale.h>
 
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -23,6 +26,8 @@ core::OptionFields CameraHeightScaleOptions::fields()
 	f.add("below_distance", belowDistance, "a point this far under a plane is below it [m, map at the estimated scale]", R::positive());
 	f.add("max_below_share", maxBelowShare, "more points below a plane than this x the least floor support: not the floor", R::atLeast(0));
 	f.add("max_tilt_deg", maxTiltDeg, "largest angle floor normal / cameras' mean -y [deg]", R::between(0, 90));
+	f.add("level_min_turn_deg", levelMinTurnDeg, "once the keyframes turned this much, a floor off their turn axis is refused [deg]; 0 = never", R::inRange(0, 360));
+	f.add("level_max_tilt_deg", levelMaxTiltDeg, "largest angle floor normal / the keyframes' turn axis [deg]", R::between(0, 90));
 	f.add("hypotheses", hypotheses, "RANSAC plane hypotheses per search round", R::atLeast(1));
 	f.add("min_floor_share", minFloorShare, "least floor support: share of the points below ...", R::aboveUpTo(0, 1));
 	f.add("min_floor_points", minFloorPoints, "... and least number of points", R::atLeast(3));
@@ -44,6 +49,7 @@ const char* toString(CameraHeightScaleFailure f)
 		case CameraHeightScaleFailure::FloorNotClear: return "floor not seen (points under every large plane)";
 		case CameraHeightScaleFailure::HeightSpread: return "cameras not at one height";
 		case CameraHeightScaleFailure::NotConverged: return "scale not converged";
+		case CameraHeightScaleFailure::OffTurnAxis: return "floor off the keyframes' turn axis";
 	}
 	return "?";
 }
@@ -131,56 +137,72 @@ BelowPoints selectBelow(
 }
 
 mrpt::math::TPoint3D toTPoint(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+
+double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+	return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
+}
+
+/** The axis the cameras turned about, for cameras without roll: their x axes lie in the
+ * floor's directions, so the floor's normal is the unit a minimizing sum_k (a . x_k)^2, the
+ * eigenvector of the smallest eigenvalue of sum_k x_k x_k^T, signed towards `up`. The turn is
+ * the range of the x axes' angles about it, measured from the direction most along them
+ * (the largest eigenvalue's eigenvector). */
+struct TurnAxis
+{
+	Eigen::Vector3d axis{Eigen::Vector3d::Zero()};
+	double turnDeg{0};
+};
+
+TurnAxis turnAxisOf(const std::vector<Eigen::Vector3d>& xAxes, const Eigen::Vector3d& up)
+{
+	TurnAxis t;
+	if (xAxes.size() < 2) return t;
+	Eigen::Matrix3d m = Eigen::Matrix3d::Zero();
+	for (const auto& x : xAxes) m += x * x.transpose();
+	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);  // eigenvalues ascending
+	t.axis = eig.eigenvectors().col(0).normalized();
+	if (t.axis.dot(up) < 0) t.axis = -t.axis;
+	const Eigen::Vector3d ref = eig.eigenvectors().col(2), side = t.axis.cross(ref);
+	double lo = 0, hi = 0;
+	for (const auto& x : xAxes)
+	{
+		const double a = std::atan2(x.dot(side), x.dot(ref));
+		lo = std::min(lo, a), hi = std::max(hi, a);
+	}
+	t.turnDeg = (hi - lo) * 180.0 / M_PI;
+	return t;
+}
 }  // namespace
 
-CameraHeightScaleResult CameraHeightScaleEstimator::estimate(
-	const std::vector<mrpt::poses::CPose3D>& T_world_cam, const std::vector<Eigen::Vector3d>& points_world) const
+namespace
 {
-	const CameraHeightScaleOptions& o = m_opts;
+/** What every plane search of one estimate shares. */
+struct SearchInput
+{
+	const std::vector<Eigen::Vector3d>& points;
+	std::vector<Eigen::Vector3d> centres;
+	std::vector<std::size_t> nearest;  //!< nearest keyframe camera of each point
+	Eigen::Vector3d centroid{Eigen::Vector3d::Zero()};
+	TurnAxis turn;
+};
+
+/** The passes of the plane search (header): the floor among the points below the cameras
+ * along `up`, first with the hint `up` and maxTiltDeg; with aroundTurnAxis every pass's hint
+ * is the turn axis and the tolerance levelMaxTiltDeg, otherwise the previous pass's floor. */
+CameraHeightScaleResult searchFloor(const CameraHeightScaleOptions& o, const SearchInput& in, Eigen::Vector3d up, bool aroundTurnAxis)
+{
 	CameraHeightScaleResult r;
-	const std::size_t nKf = T_world_cam.size();
-	if (nKf < static_cast<std::size_t>(o.minKeyframes))
-		return fail(r, CameraHeightScaleFailure::TooFewKeyframes, std::to_string(nKf) + " < min_keyframes = " + std::to_string(o.minKeyframes));
-
-	// Camera centres and "up" = mean of the cameras' -y axes (optical frame, y down).
-	std::vector<Eigen::Vector3d> centres(nKf);
-	Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), up = Eigen::Vector3d::Zero();
-	for (std::size_t k = 0; k < nKf; k++)
-	{
-		const auto& T = T_world_cam[k];
-		centres[k] = Eigen::Vector3d(T.x(), T.y(), T.z());
-		const auto R = T.getRotationMatrix();
-		const Eigen::Vector3d down(R(0, 1), R(1, 1), R(2, 1));
-		if (!finite(centres[k]) || !finite(down))
-			throw std::invalid_argument("CameraHeightScaleEstimator: keyframe pose " + std::to_string(k) + " is not finite");
-		centroid += centres[k];
-		up -= down;
-	}
-	centroid /= static_cast<double>(nKf);
-	if (!(up.norm() > 1e-6 * static_cast<double>(nKf)))
-		return fail(r, CameraHeightScaleFailure::NoFloorPlane, "the cameras' down directions cancel out: no common \"up\"");
-	up.normalize();
-
-	// Nearest keyframe camera of each point (brute force: keyframes are few).
-	std::vector<std::size_t> nearest(points_world.size());
-	for (std::size_t i = 0; i < points_world.size(); i++)
-	{
-		if (!finite(points_world[i]))
-			throw std::invalid_argument("CameraHeightScaleEstimator: point " + std::to_string(i) + " is not finite");
-		double best = std::numeric_limits<double>::infinity();
-		for (std::size_t k = 0; k < nKf; k++)
-		{
-			const double d2 = (points_world[i] - centres[k]).squaredNorm();
-			if (d2 < best) best = d2, nearest[i] = k;
-		}
-	}
-
+	r.turnDeg = in.turn.turnDeg;
+	r.searchedAroundTurnAxis = aroundTurnAxis;
+	const std::size_t nKf = in.centres.size();
+	const double tiltDeg = aroundTurnAxis ? o.levelMaxTiltDeg : o.maxTiltDeg;
 	maps::FloorFrameOptions search;
 	search.inlierDistance = o.inlierDistance;
 	search.belowDistance = o.belowDistance;
 	search.maxBelowShare = o.maxBelowShare;
 	search.searchUnderTheWinner = true;
-	search.maxTiltDeg = o.maxTiltDeg;
+	search.maxTiltDeg = tiltDeg;
 	search.hypotheses = o.hypotheses;
 	search.minSupport = o.minFloorShare;
 	search.minSupportPoints = o.minFloorPoints;
@@ -195,12 +217,12 @@ CameraHeightScaleResult CameraHeightScaleEstimator::estimate(
 	for (int pass = 1; pass <= kMaxPasses && !settled; pass++)
 	{
 		r.passes = pass;
-		const BelowPoints below = selectBelow(points_world, centres, nearest, up, o.minDepressionDeg);
+		const BelowPoints below = selectBelow(in.points, in.centres, in.nearest, up, o.minDepressionDeg);
 		r.pointsBelow = below.index.size();
 		if (r.pointsBelow < static_cast<std::size_t>(o.minPointsBelow))
 			return fail(
 				r, CameraHeightScaleFailure::TooFewPointsBelow,
-				std::to_string(r.pointsBelow) + " of " + std::to_string(points_world.size()) + " points < min_points_below = " +
+				std::to_string(r.pointsBelow) + " of " + std::to_string(in.points.size()) + " points < min_points_below = " +
 					std::to_string(o.minPointsBelow));
 		if (pass == 1)
 		{
@@ -208,27 +230,31 @@ CameraHeightScaleResult CameraHeightScaleEstimator::estimate(
 			sigma = o.cameraHeight / h0;
 		}
 		std::vector<mrpt::math::TPoint3D> pts_n(below.index.size());
-		for (std::size_t j = 0; j < below.index.size(); j++) pts_n[j] = toTPoint(sigma * (points_world[below.index[j]] - centroid));
-		for (std::size_t k = 0; k < nKf; k++) cams_n[k] = toTPoint(sigma * (centres[k] - centroid));
+		for (std::size_t j = 0; j < below.index.size(); j++) pts_n[j] = toTPoint(sigma * (in.points[below.index[j]] - in.centroid));
+		for (std::size_t k = 0; k < nKf; k++) cams_n[k] = toTPoint(sigma * (in.centres[k] - in.centroid));
 
-		const auto fit = maps::estimateLowestFloorPlane(pts_n, mrpt::math::TVector3D(up.x(), up.y(), up.z()), cams_n, search);
+		const Eigen::Vector3d& hint = aroundTurnAxis ? in.turn.axis : up;
+		const auto fit = maps::estimateLowestFloorPlane(pts_n, mrpt::math::TVector3D(hint.x(), hint.y(), hint.z()), cams_n, search);
 		if (!fit)
 		{
+			r.floorToTurnAxisDeg = std::numeric_limits<double>::quiet_NaN();
 			std::ostringstream why;
-			why << "no plane within " << o.maxTiltDeg << " deg of \"up\" holds " << o.minFloorPoints << " and " << o.minFloorShare * 100
-				<< " % of the " << r.pointsBelow << " points below the cameras with the cameras above it";
+			why << "no plane within " << tiltDeg << " deg of " << (aroundTurnAxis ? "the keyframes' turn axis" : "\"up\"") << " holds "
+				<< o.minFloorPoints << " and " << o.minFloorShare * 100 << " % of the " << r.pointsBelow
+				<< " points below the cameras with the cameras above it";
 			return fail(r, CameraHeightScaleFailure::NoFloorPlane, why.str());
 		}
 		// n . sigma (p - centroid) + d_n = 0  <=>  n . p + (d_n / sigma - n . centroid) = 0.
 		const auto& pl = fit->plane;
 		r.floorNormal = Eigen::Vector3d(pl.normal.x, pl.normal.y, pl.normal.z);
-		r.floorOffset = pl.d / sigma - r.floorNormal.dot(centroid);
+		r.floorOffset = pl.d / sigma - r.floorNormal.dot(in.centroid);
+		r.floorToTurnAxisDeg = in.turn.turnDeg > 0 ? angleDeg(r.floorNormal, in.turn.axis) : 0.0;
 		r.floorInliers = pl.inliers;
 		r.pointsUnderFloor = fit->below;
 		r.parallelPlanes = fit->parallelPlanes;
 		r.verticalPlanes = fit->verticalPlanes;
 		r.keyframeHeights.resize(nKf);
-		for (std::size_t k = 0; k < nKf; k++) r.keyframeHeights[k] = r.floorNormal.dot(centres[k]) + r.floorOffset;
+		for (std::size_t k = 0; k < nKf; k++) r.keyframeHeights[k] = r.floorNormal.dot(in.centres[k]) + r.floorOffset;
 		r.heightMap = median(r.keyframeHeights);
 		if (!fit->clearBelow)
 			return fail(
@@ -248,7 +274,8 @@ CameraHeightScaleResult CameraHeightScaleEstimator::estimate(
 	r.heightSpread = kMadToStd * median(dev) / r.heightMap;
 	std::ostringstream msg;
 	msg << "h_map = " << r.heightMap << " map units (spread " << 100 * r.heightSpread << " %), s = " << r.scale << " m per unit, floor "
-		<< r.floorInliers << " of " << r.pointsBelow << " points below the cameras, " << r.passes << " passes";
+		<< r.floorInliers << " of " << r.pointsBelow << " points below the cameras, " << r.passes << " passes, floor " << r.floorToTurnAxisDeg
+		<< " deg off the turn axis (turned " << r.turnDeg << " deg)";
 	if (!settled) return fail(r, CameraHeightScaleFailure::NotConverged, msg.str());
 	if (r.heightSpread > o.maxHeightSpread)
 	{
@@ -259,6 +286,73 @@ CameraHeightScaleResult CameraHeightScaleEstimator::estimate(
 	}
 	r.ok = true;
 	r.message = msg.str();
+	return r;
+}
+}  // namespace
+
+CameraHeightScaleResult CameraHeightScaleEstimator::estimate(
+	const std::vector<mrpt::poses::CPose3D>& T_world_cam, const std::vector<Eigen::Vector3d>& points_world) const
+{
+	const CameraHeightScaleOptions& o = m_opts;
+	CameraHeightScaleResult r;
+	const std::size_t nKf = T_world_cam.size();
+	if (nKf < static_cast<std::size_t>(o.minKeyframes))
+		return fail(r, CameraHeightScaleFailure::TooFewKeyframes, std::to_string(nKf) + " < min_keyframes = " + std::to_string(o.minKeyframes));
+
+	// Camera centres, x axes and "up" = mean of the cameras' -y axes (optical frame, y down).
+	SearchInput in{points_world, std::vector<Eigen::Vector3d>(nKf), std::vector<std::size_t>(points_world.size()), Eigen::Vector3d::Zero(), {}};
+	std::vector<Eigen::Vector3d> xAxes(nKf);
+	Eigen::Vector3d up = Eigen::Vector3d::Zero();
+	for (std::size_t k = 0; k < nKf; k++)
+	{
+		const auto& T = T_world_cam[k];
+		in.centres[k] = Eigen::Vector3d(T.x(), T.y(), T.z());
+		const auto R = T.getRotationMatrix();
+		const Eigen::Vector3d down(R(0, 1), R(1, 1), R(2, 1));
+		xAxes[k] = Eigen::Vector3d(R(0, 0), R(1, 0), R(2, 0));
+		if (!finite(in.centres[k]) || !finite(down) || !finite(xAxes[k]))
+			throw std::invalid_argument("CameraHeightScaleEstimator: keyframe pose " + std::to_string(k) + " is not finite");
+		in.centroid += in.centres[k];
+		up -= down;
+	}
+	in.centroid /= static_cast<double>(nKf);
+	if (!(up.norm() > 1e-6 * static_cast<double>(nKf)))
+		return fail(r, CameraHeightScaleFailure::NoFloorPlane, "the cameras' down directions cancel out: no common \"up\"");
+	up.normalize();
+	in.turn = turnAxisOf(xAxes, up);
+
+	// Nearest keyframe camera of each point (brute force: keyframes are few).
+	for (std::size_t i = 0; i < points_world.size(); i++)
+	{
+		if (!finite(points_world[i]))
+			throw std::invalid_argument("CameraHeightScaleEstimator: point " + std::to_string(i) + " is not finite");
+		double best = std::numeric_limits<double>::infinity();
+		for (std::size_t k = 0; k < nKf; k++)
+		{
+			const double d2 = (points_world[i] - in.centres[k]).squaredNorm();
+			if (d2 < best) best = d2, in.nearest[i] = k;
+		}
+	}
+
+	r = searchFloor(o, in, up, false);
+	// Cameras that turned enough: a floor found further than levelMaxTiltDeg off their turn
+	// axis is not the floor they move on (header) and is searched for again around that axis.
+	// A search that failed stays failed: only what would have been taken is checked.
+	const bool turned = o.levelMinTurnDeg > 0 && in.turn.turnDeg >= o.levelMinTurnDeg && angleDeg(in.turn.axis, up) <= o.maxTiltDeg;
+	if (turned && r.ok && r.floorToTurnAxisDeg > o.levelMaxTiltDeg)
+	{
+		std::ostringstream first;
+		first << "a plane " << r.floorToTurnAxisDeg << " deg off the keyframes' turn axis (turned " << in.turn.turnDeg
+			  << " deg; it gave s = " << r.scale << " m per unit) was not the floor; searched around the axis: ";
+		r = searchFloor(o, in, in.turn.axis, true);
+		if (r.ok && r.floorToTurnAxisDeg > o.levelMaxTiltDeg)
+		{
+			std::ostringstream why;
+			why << r.floorToTurnAxisDeg << " deg > level_max_tilt_deg = " << o.levelMaxTiltDeg << " after its refinement; " << r.message;
+			r = fail(r, CameraHeightScaleFailure::OffTurnAxis, why.str());
+		}
+		r.message = first.str() + r.message;
+	}
 	return r;
 }
 

@@ -19,6 +19,18 @@
  * (walls). "Up" is the mean of the keyframe cameras' -y axes (optical frame, y down): a camera
  * at a fixed height on a robot is roughly level, and the search allows maxTiltDeg off it.
  *
+ * Once the keyframes have turned (yaw) by levelMinTurnDeg or more, their orientations say
+ * where the floor is: a camera mounted on a robot without roll keeps its x axis parallel to
+ * the floor, so the x axes x_k of keyframes facing different ways span the floor's directions
+ * and the floor's normal is the direction least along them, the eigenvector of the smallest
+ * eigenvalue of sum_k x_k x_k^T (the "turn axis"). The map's scale does not touch it, and on a
+ * short, narrow path, where the cameras' positions cannot tell the floor from a plane rolled
+ * about the path, it can. A floor that would be taken but lies more than levelMaxTiltDeg off
+ * the turn axis is then refused, and the search is run again with the turn axis as its hint
+ * and levelMaxTiltDeg as its tolerance (a search that failed is not run again); its floor is
+ * refused too when its refinement (walls, furniture tops) tilted it that far off the axis. A mount roll r tilts the turn axis by up to r; the tolerance covers a few
+ * degrees of it.
+ *
  * Which points count: a point is "below the cameras" when, seen from its nearest keyframe
  * camera, it lies at least minDepressionDeg under the horizontal (the plane through the camera
  * perpendicular to "up"). The test is an angle, so it needs no scale; it drops the ceiling and
@@ -87,6 +99,13 @@ struct CameraHeightScaleOptions : public core::FieldTableOptions<CameraHeightSca
 	/** Largest angle between the floor's normal and the cameras' mean -y axis [deg]: covers a
 	 * camera pitched down towards the floor (Default: 40 deg) */
 	double maxTiltDeg{40.0};
+	/** Once the keyframes' x axes have turned this much about one axis, a floor further than
+	 * levelMaxTiltDeg off that axis is refused and searched for around it [deg]; 0 = never
+	 * (Default: 15 deg) */
+	double levelMinTurnDeg{15.0};
+	/** Largest angle between the floor's normal and the keyframes' turn axis [deg]: the mount's
+	 * roll and the rotations' noise (Default: 4 deg) */
+	double levelMaxTiltDeg{4.0};
 	/** RANSAC plane hypotheses per search round (Default: 3000) */
 	int hypotheses{3000};
 	/** Least floor support: this share of the points below the cameras ... (Default: 0.02) */
@@ -113,7 +132,8 @@ enum class CameraHeightScaleFailure
 	NoFloorPlane,  //!< no large plane near perpendicular to "up" with the cameras above it
 	FloorNotClear,  //!< every large plane has many points under it: the floor was not seen
 	HeightSpread,  //!< the keyframes' heights above the floor spread more than maxHeightSpread
-	NotConverged  //!< the scale kept changing between searches
+	NotConverged,  //!< the scale kept changing between searches
+	OffTurnAxis  //!< the floor found around the turn axis ended levelMaxTiltDeg or more off it
 };
 
 const char* toString(CameraHeightScaleFailure f);
@@ -124,7 +144,7 @@ struct CameraHeightScaleResult
 	CameraHeightScaleFailure failure{CameraHeightScaleFailure::None};
 	std::string message;  //!< why it failed (or what it found), with the numbers
 	/** s = cameraHeight / heightMap: metres per map unit; 0 when no floor was accepted (also set when refused for
-	 * HeightSpread or NotConverged) */
+	 * HeightSpread, NotConverged or OffTurnAxis) */
 	double scale{0};
 	/** Median of keyframeHeights [map units] */
 	double heightMap{0};
@@ -143,6 +163,13 @@ struct CameraHeightScaleResult
 	/** Horizontal (the floor included) and vertical planes the floor's tilt was fitted to */
 	std::size_t parallelPlanes{0}, verticalPlanes{0};
 	int passes{0};  //!< plane searches run (each on the map rescaled by the previous scale)
+	/** How far the keyframes' x axes turned about their turn axis [deg] (0 with fewer than
+	 * two keyframes), and whether the floor was searched for around that axis (the keyframes
+	 * turned levelMinTurnDeg or more and the first search's floor lay off it) */
+	double turnDeg{0};
+	bool searchedAroundTurnAxis{false};
+	/** Angle between the floor found and the turn axis [deg]; NaN when no plane was found */
+	double floorToTurnAxisDeg{0};
 };
 
 class CameraHeightScaleEstimator
