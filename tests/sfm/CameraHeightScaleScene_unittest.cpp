@@ -138,6 +138,11 @@ TEST_P(CameraHeightScaleScene, RecoversTheMetricScaleFromTheCameraHeight)
 	// The floor's normal is the world's up: a tilt of 1 deg would move the floor under a camera
 	// 1 m from the floor points' centroid by 1.7 cm, 1.3 % of the camera's height.
 	EXPECT_GT(r.floorNormal.dot(Q * Eigen::Vector3d::UnitZ()), std::cos(1.0 * M_PI / 180.0));
+	// The simulator's cameras have no roll: every x axis is horizontal, so the turn axis is the
+	// world's up (to rounding), and both loops turn the camera all the way round.
+	EXPECT_LT((r.turnAxis - Q * Eigen::Vector3d::UnitZ()).norm(), 1e-9);
+	EXPECT_GT(r.turnDeg, 300.0);
+	EXPECT_LT(r.floorToTurnAxisDeg, 1.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(

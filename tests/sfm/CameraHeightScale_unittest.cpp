@@ -422,6 +422,7 @@ TEST(CameraHeightScale, APlaneRolledAboutTheCamerasPathIsNotTheFloorOnceTheyTurn
 	EXPECT_EQ(r.failure, CameraHeightScaleFailure::NoFloorPlane) << r.message;
 	EXPECT_TRUE(r.searchedAroundTurnAxis);
 	EXPECT_NEAR(r.turnDeg, 90.0, 1e-6);
+	EXPECT_LT((r.turnAxis - Eigen::Vector3d::UnitZ()).norm(), 1e-9);
 	// With the floor seen (500 points, a third of the rolled plane's, in y < 0.5 where the
 	// rolled plane runs under it), the search around the turn axis takes it: the true scale 1.
 	auto withFloor = points;

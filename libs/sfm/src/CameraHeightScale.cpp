@@ -194,6 +194,7 @@ CameraHeightScaleResult searchFloor(const CameraHeightScaleOptions& o, const Sea
 {
 	CameraHeightScaleResult r;
 	r.turnDeg = in.turn.turnDeg;
+	r.turnAxis = in.turn.axis;
 	r.searchedAroundTurnAxis = aroundTurnAxis;
 	const std::size_t nKf = in.centres.size();
 	const double tiltDeg = aroundTurnAxis ? o.levelMaxTiltDeg : o.maxTiltDeg;

@@ -167,6 +167,9 @@ struct CameraHeightScaleResult
 	 * two keyframes), and whether the floor was searched for around that axis (the keyframes
 	 * turned levelMinTurnDeg or more and the first search's floor lay off it) */
 	double turnDeg{0};
+	/** The turn axis in the map's frame (unit, towards the cameras' mean -y; zero with fewer
+	 * than two keyframes) */
+	Eigen::Vector3d turnAxis{Eigen::Vector3d::Zero()};
 	bool searchedAroundTurnAxis{false};
 	/** Angle between the floor found and the turn axis [deg]; NaN when no plane was found */
 	double floorToTurnAxisDeg{0};
