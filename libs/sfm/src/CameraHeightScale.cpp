@@ -1,5 +1,6 @@
 // CameraHeightScaleEstimator: the floor among the map points below the keyframe cameras (the
 // RGB-D floor frame's lowest-plane search), the cameras' height above it, s = camera_height / h.
+#include <keygrid/core/VectorAngle.h>
 #include <keygrid/maps/FloorFrameEstimator.h>
 #include <keygrid/sfm/CameraHeightScale.h>
 
@@ -138,10 +139,7 @@ BelowPoints selectBelow(
 
 mrpt::math::TPoint3D toTPoint(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
 
-double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
-{
-	return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
-}
+double angleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) { return core::angleBetween(a, b) * 180.0 / M_PI; }
 
 /** The axis the cameras turned about, for cameras without roll: their x axes lie in the
  * floor's directions, so the floor's normal is the unit a minimizing sum_k (a . x_k)^2, the
@@ -173,10 +171,7 @@ TurnAxis turnAxisOf(const std::vector<Eigen::Vector3d>& xAxes, const Eigen::Vect
 	t.turnDeg = (hi - lo) * 180.0 / M_PI;
 	return t;
 }
-}  // namespace
 
-namespace
-{
 /** What every plane search of one estimate shares. */
 struct SearchInput
 {
@@ -238,7 +233,6 @@ CameraHeightScaleResult searchFloor(const CameraHeightScaleOptions& o, const Sea
 		const auto fit = maps::estimateLowestFloorPlane(pts_n, mrpt::math::TVector3D(hint.x(), hint.y(), hint.z()), cams_n, search);
 		if (!fit)
 		{
-			r.floorToTurnAxisDeg = std::numeric_limits<double>::quiet_NaN();
 			std::ostringstream why;
 			why << "no plane within " << tiltDeg << " deg of " << (aroundTurnAxis ? "the keyframes' turn axis" : "\"up\"") << " holds "
 				<< o.minFloorPoints << " and " << o.minFloorShare * 100 << " % of the " << r.pointsBelow

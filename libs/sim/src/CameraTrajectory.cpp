@@ -1,5 +1,6 @@
 #include "IniHelpers.h"
 
+#include <keygrid/core/VectorAngle.h>
 #include <keygrid/sim/CameraTrajectory.h>
 #include <mrpt/math/CMatrixFixed.h>
 
@@ -14,11 +15,6 @@ namespace keygrid::sim
 namespace
 {
 Eigen::Vector3d dirOf(const Waypoint& w) { return (w.target - w.eye).normalized(); }
-
-double angleBetween(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
-{
-	return std::atan2(a.cross(b).norm(), a.dot(b));
-}
 
 // Cubic Hermite on [0, 1] with end velocities already scaled by the segment duration.
 Eigen::Vector3d hermite(
@@ -67,7 +63,7 @@ CameraTrajectory::CameraTrajectory(
 		const Waypoint& a = m_wps[i];
 		const Waypoint& b = m_wps[(i + 1) % n];
 		const double len = (b.eye - a.eye).norm();
-		const double turn = angleBetween(dirOf(a), dirOf(b));
+		const double turn = core::angleBetween(dirOf(a), dirOf(b));
 		weight[i] =
 			std::max({len / opts.refSpeed, turn / (opts.refTurnRateDeg * M_PI / 180.0), 1e-6});
 		sum += weight[i];

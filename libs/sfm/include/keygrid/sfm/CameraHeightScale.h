@@ -28,8 +28,8 @@
  * about the path, it can. A floor that would be taken but lies more than levelMaxTiltDeg off
  * the turn axis is then refused, and the search is run again with the turn axis as its hint
  * and levelMaxTiltDeg as its tolerance (a search that failed is not run again); its floor is
- * refused too when its refinement (walls, furniture tops) tilted it that far off the axis. A mount roll r tilts the turn axis by up to r; the tolerance covers a few
- * degrees of it.
+ * refused too when its refinement (walls, furniture tops) tilted it that far off the axis.
+ * A mount roll r tilts the turn axis by about r; the tolerance covers a few degrees of it.
  *
  * Which points count: a point is "below the cameras" when, seen from its nearest keyframe
  * camera, it lies at least minDepressionDeg under the horizontal (the plane through the camera
@@ -61,6 +61,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -163,16 +164,15 @@ struct CameraHeightScaleResult
 	/** Horizontal (the floor included) and vertical planes the floor's tilt was fitted to */
 	std::size_t parallelPlanes{0}, verticalPlanes{0};
 	int passes{0};  //!< plane searches run (each on the map rescaled by the previous scale)
-	/** How far the keyframes' x axes turned about their turn axis [deg] (0 with fewer than
-	 * two keyframes), and whether the floor was searched for around that axis (the keyframes
-	 * turned levelMinTurnDeg or more and the first search's floor lay off it) */
-	double turnDeg{0};
-	/** The turn axis in the map's frame (unit, towards the cameras' mean -y; zero with fewer
-	 * than two keyframes) */
+	/** The turn axis in the map's frame (unit, towards the cameras' mean -y) and how far the
+	 * keyframes' x axes turned about it [deg]; zero with fewer than two keyframes */
 	Eigen::Vector3d turnAxis{Eigen::Vector3d::Zero()};
+	double turnDeg{0};
+	/** The floor was searched for around the turn axis: the keyframes turned levelMinTurnDeg
+	 * or more and the first search's floor lay off it */
 	bool searchedAroundTurnAxis{false};
 	/** Angle between the floor found and the turn axis [deg]; NaN when no plane was found */
-	double floorToTurnAxisDeg{0};
+	double floorToTurnAxisDeg{std::numeric_limits<double>::quiet_NaN()};
 };
 
 class CameraHeightScaleEstimator
