@@ -1,4 +1,5 @@
-// The inline bit count used for binary descriptors against std::bitset (an independent count).
+// The bit counts used for binary descriptors (inline, and the table scan with its POPCNT build)
+// against std::bitset (an independent count).
 #include <gtest/gtest.h>
 #include <keygrid/core/Hamming.h>
 
@@ -31,4 +32,27 @@ TEST(Hamming, DistanceOfOrbSizedDescriptors)
 	EXPECT_EQ(hammingDistance(a, b, 4), 9);
 	for (int i = 0; i < 4; i++) b[i] = ~a[i];
 	EXPECT_EQ(hammingDistance(a, b, 4), 256);
+}
+
+TEST(Hamming, DistancesAgainstATableMatchBitsetCounts)
+{
+	// A table of 37 descriptors of 4 words in rows of 5 words (a padded stride), against one
+	// query; the last row differs in every bit, the first in none.
+	std::mt19937_64 g(23);
+	constexpr int kRows = 37, kWords = 4;
+	constexpr std::size_t kStride = 5;
+	std::uint64_t q[kWords], table[kRows * kStride];
+	for (auto& w : q) w = g();
+	for (auto& w : table) w = g();
+	for (int w = 0; w < kWords; w++) table[w] = q[w], table[(kRows - 1) * kStride + w] = ~q[w];
+	int out[kRows];
+	keygrid::core::hammingDistances(q, table, kStride, kRows, kWords, out);
+	for (int r = 0; r < kRows; r++)
+	{
+		std::size_t bits = 0;
+		for (int w = 0; w < kWords; w++) bits += std::bitset<64>(q[w] ^ table[r * kStride + w]).count();
+		EXPECT_EQ(out[r], static_cast<int>(bits)) << "row " << r;
+	}
+	EXPECT_EQ(out[0], 0);
+	EXPECT_EQ(out[kRows - 1], 256);
 }

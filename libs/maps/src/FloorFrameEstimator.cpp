@@ -9,8 +9,13 @@
 #include <mrpt/math/geometry.h>
 
 #include <Eigen/Eigenvalues>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+#include <cstdint>
 #include <algorithm>
 #include <limits>
+#include <optional>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -104,6 +109,77 @@ Counts count(const std::vector<TPoint3D>& pts, const FloorPlane& pl, double tol,
 		const double h = pl.height(p);
 		if (std::abs(h) <= tol) c.inliers++;
 		else if (h < -belowDist) c.below++;
+	}
+	return c;
+}
+
+/** The RANSAC's scoring subsample as three coordinate arrays, which countRange reads two
+ * points at a time (the hypotheses are thousands per search). */
+struct ScorePoints
+{
+	std::vector<double> x, y, z;
+	explicit ScorePoints(const std::vector<TPoint3D>& pts)
+	{
+		x.reserve(pts.size()), y.reserve(pts.size()), z.reserve(pts.size());
+		for (const auto& p : pts) x.push_back(p.x), y.push_back(p.y), z.push_back(p.z);
+	}
+	std::size_t size() const { return x.size(); }
+};
+
+/** count() of the points [begin, end) of s, added to c: the same heights as
+ * FloorPlane::height (the same operations in the same order), two points at a time with SSE2
+ * (GCC does not vectorise the two conditional counts by itself). */
+void countRange(const ScorePoints& s, const FloorPlane& pl, double tol, double belowDist, std::size_t begin, std::size_t end, Counts& c)
+{
+	const double nx = pl.normal.x, ny = pl.normal.y, nz = pl.normal.z, d = pl.d, low = -belowDist;
+	const double* x = s.x.data();
+	const double* y = s.y.data();
+	const double* z = s.z.data();
+	std::size_t i = begin, inliers = 0, below = 0;
+#if defined(__SSE2__)
+	const __m128d vnx = _mm_set1_pd(nx), vny = _mm_set1_pd(ny), vnz = _mm_set1_pd(nz), vd = _mm_set1_pd(d);
+	const __m128d vtol = _mm_set1_pd(tol), vlow = _mm_set1_pd(low), sign = _mm_set1_pd(-0.0);
+	__m128i vin = _mm_setzero_si128(), vbelow = _mm_setzero_si128();
+	for (; i + 2 <= end; i += 2)
+	{
+		const __m128d h = _mm_add_pd(
+			_mm_add_pd(_mm_add_pd(_mm_mul_pd(vnx, _mm_loadu_pd(x + i)), _mm_mul_pd(vny, _mm_loadu_pd(y + i))), _mm_mul_pd(vnz, _mm_loadu_pd(z + i))),
+			vd);
+		const __m128d in = _mm_cmple_pd(_mm_andnot_pd(sign, h), vtol);  // all ones where |h| <= tol
+		const __m128d under = _mm_andnot_pd(in, _mm_cmplt_pd(h, vlow));
+		vin = _mm_sub_epi64(vin, _mm_castpd_si128(in));  // all ones is -1
+		vbelow = _mm_sub_epi64(vbelow, _mm_castpd_si128(under));
+	}
+	std::int64_t lanes[2];
+	_mm_storeu_si128(reinterpret_cast<__m128i*>(lanes), vin);
+	inliers += static_cast<std::size_t>(lanes[0] + lanes[1]);
+	_mm_storeu_si128(reinterpret_cast<__m128i*>(lanes), vbelow);
+	below += static_cast<std::size_t>(lanes[0] + lanes[1]);
+#endif
+	for (; i < end; i++)
+	{
+		const double h = nx * x[i] + ny * y[i] + nz * z[i] + d;
+		const bool in = std::abs(h) <= tol;
+		inliers += in;
+		below += !in && h < low;
+	}
+	c.inliers += inliers;
+	c.below += below;
+}
+
+/** count() on the scoring subsample, for a hypothesis that only matters as a clear plane (at
+ * most maxBelow points below) with more than `beat` inliers: nullopt as soon as it cannot be
+ * one, checked between blocks of points. */
+std::optional<Counts> countToBeat(const ScorePoints& s, const FloorPlane& pl, double tol, double belowDist, double maxBelow, std::size_t beat)
+{
+	constexpr std::size_t kBlock = 512;
+	Counts c;
+	const std::size_t n = s.size();
+	for (std::size_t start = 0; start < n; start += kBlock)
+	{
+		const std::size_t end = std::min(n, start + kBlock);
+		countRange(s, pl, tol, belowDist, start, end, c);
+		if (static_cast<double>(c.below) > maxBelow || c.inliers + (n - end) <= beat) return std::nullopt;
 	}
 	return c;
 }
@@ -364,6 +440,7 @@ std::optional<FloorPlaneFit> estimateLowestFloorPlane(
 	const double scale = static_cast<double>(score.size()) / static_cast<double>(n);
 	const double minSupportS = std::max(3.0, std::floor(static_cast<double>(minSupport) * scale));
 	const double maxBelowS = maxBelow * scale;
+	const ScorePoints scoreSoA(score);
 
 	std::mt19937 rng(o.seed);
 	TVector3D up = upIn * (1.0 / upNorm);
@@ -400,7 +477,16 @@ std::optional<FloorPlaneFit> estimateLowestFloorPlane(
 			pl.normal = nrm;
 			pl.d = -dot(nrm, TVector3D(a.x, a.y, a.z));
 			if (!camerasAbove(cams, pl, o.minCameraHeight)) continue;
-			const Counts k = count(score, pl, o.inlierDistance, o.belowDistance);
+			// Once a clear plane is found the fallback is no longer used: a hypothesis only
+			// matters as a clear plane with more inliers, and its count stops once it cannot be.
+			if (clear)
+			{
+				const auto k = countToBeat(scoreSoA, pl, o.inlierDistance, o.belowDistance, maxBelowS, clearC.inliers);
+				if (k && static_cast<double>(k->inliers) >= minSupportS) clear = pl, clearC = *k;
+				continue;
+			}
+			Counts k;
+			countRange(scoreSoA, pl, o.inlierDistance, o.belowDistance, 0, scoreSoA.size(), k);
 			if (static_cast<double>(k.inliers) < minSupportS) continue;
 			if (static_cast<double>(k.below) <= maxBelowS)
 			{

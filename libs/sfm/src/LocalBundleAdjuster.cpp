@@ -29,14 +29,22 @@ class AnalyticBaCost final : public ceres::SizedCostFunction<3, 4, 3, 3>
 	AnalyticReprojectionCost m_cost;
 };
 
-/** Up to this many optimised keyframes the reduced camera system is solved densely. */
+/** Up to this many optimised keyframes, `linear_solver = auto` leaves a problem without depth
+ * measurements to Ceres' dense Schur (and with autodiff Jacobians, any problem). */
 constexpr std::size_t kAutoDenseMaxKeyFrames = 60;
 
-/** `linear_solver = auto` with analytic Jacobians: Ceres' dense Schur for local windows, the
- * dedicated sparse solver (BundleLevenbergMarquardt.h) for larger problems. */
-bool usesDedicatedSolver(const BundleAdjusterOptions& o, std::size_t movingKeyFrames)
+/** `linear_solver = auto` with analytic Jacobians: the dedicated sparse solver
+ * (BundleLevenbergMarquardt.h) for every problem with depth measurements, local windows
+ * included, and for every problem of more than kAutoDenseMaxKeyFrames moving keyframes. It
+ * reaches the optimum Ceres' Schur solvers reach, without their problem building and
+ * preprocessing, which dominate on a local window. A monocular window (no depth) keeps Ceres'
+ * dense Schur: its scale is held by the fixed keyframes alone, the two solvers move it apart
+ * along that weak direction, and on a validation scene the monocular runs ended worse
+ * (doc/frontend.md, "Local mapping cost"). */
+bool usesDedicatedSolver(const BundleAdjusterOptions& o, std::size_t movingKeyFrames, bool depthMeasured)
 {
-	return o.linearSolver == BaLinearSolver::Auto && o.analyticJacobians && movingKeyFrames > kAutoDenseMaxKeyFrames;
+	if (o.linearSolver == BaLinearSolver::Dedicated) return true;
+	return o.linearSolver == BaLinearSolver::Auto && o.analyticJacobians && (depthMeasured || movingKeyFrames > kAutoDenseMaxKeyFrames);
 }
 
 const char* solverName(BaLinearSolver s)
@@ -46,6 +54,7 @@ const char* solverName(BaLinearSolver s)
 		case BaLinearSolver::DenseSchur: return "dense_schur";
 		case BaLinearSolver::SparseSchur: return "sparse_schur";
 		case BaLinearSolver::IterativeSchur: return "iterative_schur";
+		case BaLinearSolver::Dedicated: return "dedicated";
 		default: return "auto";
 	}
 }
@@ -59,21 +68,22 @@ core::OptionFields BundleAdjusterOptions::fields()
 	f.add("max_fixed_keyframes", maxFixedKeyFrames, "fixed keyframes anchoring the window");
 	f.add("iterations", iterations, "Levenberg-Marquardt iterations at most", R::atLeast(1));
 	f.add("function_tolerance", functionTolerance, "stop once an iteration lowers the cost by less than this fraction", R::fromBelow(0, 1));
-	f.add("threads", threads, "Ceres threads (1 = deterministic)", R::atLeast(1));
+	f.add("threads", threads, "threads of the Ceres solvers (1 = deterministic; auto's dedicated solver always runs two, deterministically)", R::atLeast(1));
 	f.add("analytic_jacobians", analyticJacobians, "hand-written Jacobians (false: Ceres autodiff)");
 	f.addCustom(
 		"linear_solver",
 		{[this](const std::string& text) {
-			 for (auto v : {BaLinearSolver::Auto, BaLinearSolver::DenseSchur, BaLinearSolver::SparseSchur, BaLinearSolver::IterativeSchur})
+			 for (auto v : {BaLinearSolver::Auto, BaLinearSolver::DenseSchur, BaLinearSolver::SparseSchur, BaLinearSolver::IterativeSchur,
+						   BaLinearSolver::Dedicated})
 				 if (text == solverName(v))
 				 {
 					 linearSolver = v;
 					 return;
 				 }
-			 throw std::invalid_argument("expected auto, dense_schur, sparse_schur or iterative_schur");
+			 throw std::invalid_argument("expected auto, dense_schur, sparse_schur, iterative_schur or dedicated");
 		 },
 		 [this] { return std::string(solverName(linearSolver)); }},
-		"Ceres linear solver: auto | dense_schur | sparse_schur | iterative_schur");
+		"linear solver: auto (keygrid's dedicated sparse Schur; Ceres' dense Schur for monocular windows) | dense_schur | sparse_schur | iterative_schur (Ceres) | dedicated (keygrid's, every problem)");
 	return f;
 }
 
@@ -280,7 +290,8 @@ BundleAdjustment::BundleAdjustment(
 				1.0 / f.levelScale[f.keypoints[kp].octave], pi->second, lmRow});
 		}
 	}
-	m->dedicated = usesDedicatedSolver(o, local.size());
+	const bool depthMeasured = std::any_of(all.begin(), all.end(), [](const Problem::Obs& ob) { return ob.rgbd; });
+	m->dedicated = usesDedicatedSolver(o, local.size(), depthMeasured);
 	if (!m->dedicated) m->buildCeresProblem();
 	rep.keyframes = static_cast<int>(local.size());
 	rep.fixedKeyFrames = static_cast<int>(fixedSet.size());

@@ -1,9 +1,12 @@
+#include <keygrid/core/Hamming.h>
 #include <keygrid/core/NearestTwo.h>
 #include <keygrid/sfm/Matcher.h>
 #include <opencv2/features2d.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 #include <limits>
 
 namespace keygrid::sfm
@@ -104,25 +107,48 @@ std::vector<std::pair<int, int>> matchBruteForce(
 	return out;
 }
 
+namespace
+{
+/** Distances of row i of `q` to every row of `table`, into out (resized): one Hamming table
+ * scan for binary descriptors (core::hammingDistances), descriptorDistance otherwise. */
+void rowDistances(const cv::Mat& q, int i, const cv::Mat& table, std::vector<float>& out)
+{
+	const int n = table.rows;
+	out.resize(static_cast<std::size_t>(n));
+	if (q.type() == CV_8U && table.type() == CV_8U && q.cols == table.cols && q.cols % 8 == 0 && table.isContinuous())
+	{
+		thread_local std::vector<int> bits;
+		bits.resize(static_cast<std::size_t>(n));
+		core::hammingDistances(q.ptr<std::uint64_t>(i), table.ptr<std::uint64_t>(0), table.step1() / 8, n, q.cols / 8, bits.data());
+		for (int j = 0; j < n; j++) out[static_cast<std::size_t>(j)] = static_cast<float>(bits[static_cast<std::size_t>(j)]);
+		return;
+	}
+	for (int j = 0; j < n; j++) out[static_cast<std::size_t>(j)] = descriptorDistance(q, i, table, j);
+}
+}  // namespace
+
 std::vector<std::pair<int, int>> matchSubsetBruteForce(
 	const FrameFeatures& a, const std::vector<int>& ia, const FrameFeatures& b, float maxDist, float ratio)
 {
 	std::vector<std::pair<int, int>> out;
 	const int na = a.descriptors.rows, nb = b.descriptors.rows;
 	if (ia.empty() || nb == 0) return out;
+	std::vector<float> toB, toA;
 	for (int i : ia)
 	{
+		rowDistances(a.descriptors, i, b.descriptors, toB);
 		core::NearestTwo<float> nearest;
-		for (int j = 0; j < nb; j++) nearest.add(descriptorDistance(a.descriptors, i, b.descriptors, j), j);
+		for (int j = 0; j < nb; j++) nearest.add(toB[static_cast<std::size_t>(j)], j);
 		const int best = nearest.index;
 		const float d1 = nearest.best;
 		if (d1 > maxDist || (nb > 1 && d1 > ratio * nearest.second)) continue;
 		// Mutual best: b's keypoint has no closer keypoint in a (nor an equal one before i).
+		rowDistances(b.descriptors, best, a.descriptors, toA);
 		bool mutual = true;
 		for (int k = 0; k < na && mutual; k++)
 		{
 			if (k == i) continue;
-			const float d = descriptorDistance(a.descriptors, k, b.descriptors, best);
+			const float d = toA[static_cast<std::size_t>(k)];
 			if (d < d1 || (d == d1 && k < i)) mutual = false;
 		}
 		if (mutual) out.emplace_back(i, best);

@@ -7,6 +7,7 @@
  * time. Without -mpopcnt the bit count is done inline instead, by the classic parallel
  * ("SWAR") reduction: sums of 2, 4, 8 bits in place, then one multiply adds the 8 byte sums
  * into the top byte. */
+#include <cstddef>
 #include <cstdint>
 
 namespace keygrid::core
@@ -30,4 +31,10 @@ inline int hammingDistance(const std::uint64_t* a, const std::uint64_t* b, int w
 	for (int w = 0; w < words; w++) d += popcount64(a[w] ^ b[w]);
 	return d;
 }
+
+/** out[r] = hammingDistance(q, rows + r * strideWords, words) for r in [0, n): one descriptor
+ * against a table of them, the inner loop of brute-force matching. On x86-64 without -mpopcnt
+ * it runs a POPCNT build of the loop when the CPU has the instruction (checked once), the
+ * inline count otherwise; both give the same distances. */
+void hammingDistances(const std::uint64_t* q, const std::uint64_t* rows, std::size_t strideWords, int n, int words, int* out);
 }  // namespace keygrid::core

@@ -20,15 +20,20 @@ namespace keygrid::sfm
 /** Linear solver of the Levenberg-Marquardt steps (all eliminate the landmarks first). */
 enum class BaLinearSolver
 {
-	/** Ceres' DenseSchur up to 60 optimised keyframes; above, the dedicated sparse solver
-	 * (BundleLevenbergMarquardt.h; Ceres' SparseSchur with autodiff Jacobians) */
+	/** The dedicated sparse solver (BundleLevenbergMarquardt.h) for every problem with depth
+	 * measurements and every problem of more than 60 optimised keyframes; Ceres' DenseSchur
+	 * for a monocular window (no depth, at most 60 keyframes). With autodiff Jacobians
+	 * (analytic_jacobians = false): Ceres' DenseSchur up to 60 keyframes, SparseSchur above */
 	Auto,
-	/** Dense Cholesky of the reduced camera system */
+	/** Ceres: dense Cholesky of the reduced camera system */
 	DenseSchur,
-	/** SuiteSparse Cholesky of the reduced camera system */
+	/** Ceres: SuiteSparse Cholesky of the reduced camera system */
 	SparseSchur,
-	/** Conjugate gradients on the reduced system, Schur-Jacobi preconditioner */
-	IterativeSchur
+	/** Ceres: conjugate gradients on the reduced system, Schur-Jacobi preconditioner */
+	IterativeSchur,
+	/** The dedicated sparse solver for every problem, monocular windows included (analytic
+	 * Jacobians whatever analytic_jacobians says) */
+	Dedicated
 };
 
 struct BundleAdjusterOptions : public core::FieldTableOptions<BundleAdjusterOptions>
@@ -53,7 +58,8 @@ struct BundleAdjusterOptions : public core::FieldTableOptions<BundleAdjusterOpti
 	double disparitySigma{0.25};
 	/** Depth residuals only for depths below this [m] (Default: 6) */
 	double maxDepthForRgbd{6.0};
-	/** Threads used by Ceres (Default: 1; results are then deterministic) */
+	/** Threads used by the Ceres solvers (Default: 1; results are then deterministic). The
+	 * dedicated solver of `auto` runs two threads whatever this says, with deterministic results. */
 	int threads{1};
 	/** Hand-written Jacobians (AnalyticReprojectionCost); false: Ceres autodiff of the
 	 * templated costs (Default: true) */
@@ -64,7 +70,7 @@ struct BundleAdjusterOptions : public core::FieldTableOptions<BundleAdjusterOpti
 	 * (Default: 0; the final global bundle adjustment uses [mapping] min_parallax_deg) */
 	double minParallaxDegWithoutDepth{0};
 	/** Linear solver, INI `linear_solver` = auto | dense_schur | sparse_schur |
-	 * iterative_schur (Default: auto) */
+	 * iterative_schur | dedicated (Default: auto) */
 	BaLinearSolver linearSolver{BaLinearSolver::Auto};
 
 	/** The bundle adjustment's keys (in [mapping]). */
