@@ -38,9 +38,9 @@ constexpr std::size_t kAutoDenseMaxKeyFrames = 60;
  * included, and for every problem of more than kAutoDenseMaxKeyFrames moving keyframes. It
  * reaches the optimum Ceres' Schur solvers reach, without their problem building and
  * preprocessing, which dominate on a local window. A monocular window (no depth) keeps Ceres'
- * dense Schur: its scale is held by the fixed keyframes alone, the two solvers move it apart
- * along that weak direction, and on a validation scene the monocular runs ended worse
- * (doc/frontend.md, "Local mapping cost"). */
+ * dense Schur: with the dedicated solver, monocular runs of a validation scene ended off in
+ * scale more often (doc/frontend.md, "Local mapping cost"; the likely reason: such a window's
+ * scale is held by its fixed keyframes alone, a weak direction the solvers' rounding moves). */
 bool usesDedicatedSolver(const BundleAdjusterOptions& o, std::size_t movingKeyFrames, bool depthMeasured)
 {
 	if (o.linearSolver == BaLinearSolver::Dedicated) return true;
