@@ -384,8 +384,9 @@ TEST(LocalBundleAdjuster, OptionsRoundTripAndRejectUnknownSolver)
 		EXPECT_THROW(back.loadFromConfigFile(cfg, "mapping"), std::invalid_argument) << bad;
 	}
 	cfg = mrpt::config::CConfigFileMemory("[mapping]\nlinear_solver = dedicated\n");
-	back.loadFromConfigFile(cfg, "mapping");
-	EXPECT_EQ(back.linearSolver, BaLinearSolver::Dedicated);
+	BundleAdjusterOptions dedicated;
+	dedicated.loadFromConfigFile(cfg, "mapping");
+	EXPECT_EQ(dedicated.linearSolver, BaLinearSolver::Dedicated);
 	cfg = mrpt::config::CConfigFileMemory("[mapping]\nlinear_solver = cholmod\n");
 	try
 	{
