@@ -110,14 +110,14 @@ std::vector<std::pair<int, int>> matchBruteForce(
 namespace
 {
 /** Distances of row i of `q` to every row of `table`, into out (resized): one Hamming table
- * scan for binary descriptors (core::hammingDistances), descriptorDistance otherwise. */
-void rowDistances(const cv::Mat& q, int i, const cv::Mat& table, std::vector<float>& out)
+ * scan for binary descriptors (core::hammingDistances, into the caller's scratch `bits`),
+ * descriptorDistance otherwise. */
+void rowDistances(const cv::Mat& q, int i, const cv::Mat& table, std::vector<int>& bits, std::vector<float>& out)
 {
 	const int n = table.rows;
 	out.resize(static_cast<std::size_t>(n));
 	if (q.type() == CV_8U && table.type() == CV_8U && q.cols == table.cols && q.cols % 8 == 0 && table.isContinuous())
 	{
-		thread_local std::vector<int> bits;
 		bits.resize(static_cast<std::size_t>(n));
 		core::hammingDistances(q.ptr<std::uint64_t>(i), table.ptr<std::uint64_t>(0), table.step1() / 8, n, q.cols / 8, bits.data());
 		for (int j = 0; j < n; j++) out[static_cast<std::size_t>(j)] = static_cast<float>(bits[static_cast<std::size_t>(j)]);
@@ -134,16 +134,17 @@ std::vector<std::pair<int, int>> matchSubsetBruteForce(
 	const int na = a.descriptors.rows, nb = b.descriptors.rows;
 	if (ia.empty() || nb == 0) return out;
 	std::vector<float> toB, toA;
+	std::vector<int> bits;
 	for (int i : ia)
 	{
-		rowDistances(a.descriptors, i, b.descriptors, toB);
+		rowDistances(a.descriptors, i, b.descriptors, bits, toB);
 		core::NearestTwo<float> nearest;
 		for (int j = 0; j < nb; j++) nearest.add(toB[static_cast<std::size_t>(j)], j);
 		const int best = nearest.index;
 		const float d1 = nearest.best;
 		if (d1 > maxDist || (nb > 1 && d1 > ratio * nearest.second)) continue;
 		// Mutual best: b's keypoint has no closer keypoint in a (nor an equal one before i).
-		rowDistances(b.descriptors, best, a.descriptors, toA);
+		rowDistances(b.descriptors, best, a.descriptors, bits, toA);
 		bool mutual = true;
 		for (int k = 0; k < na && mutual; k++)
 		{
