@@ -453,6 +453,61 @@ TEST(CameraHeightScale, APlaneRolledAboutTheCamerasPathIsNotTheFloorOnceTheyTurn
 	EXPECT_NEAR(straight.scale, kCameraHeight / hRolled, 0.01);
 }
 
+namespace
+{
+/** A floor strip (z = 0) under the path of straightPathTurning and, beside it, a larger table
+ * top 0.7 m high tilted by `topTiltDeg` about x (rising towards +y); Gaussian noise. */
+std::vector<Eigen::Vector3d> floorAndTiltedTop(double topTiltDeg, unsigned seed)
+{
+	std::mt19937 rng(seed);
+	std::uniform_real_distribution<double> U(0, 1);
+	std::normal_distribution<double> N(0, kNoise);
+	std::vector<Eigen::Vector3d> pts;
+	for (int i = 0; i < 600; i++) pts.emplace_back(-3 + 6 * U(rng) + N(rng), -2.5 + 2.5 * U(rng) + N(rng), N(rng));
+	for (int i = 0; i < 2400; i++)
+	{
+		const double x = -3 + 6 * U(rng), y = 0.5 + 2.5 * U(rng);
+		pts.emplace_back(x + N(rng), y + N(rng), 0.7 + (y - 1.75) * std::tan(topTiltDeg * kDeg) + N(rng));
+	}
+	return pts;
+}
+
+double angleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
+{
+	return std::atan2(a.cross(b).norm(), a.dot(b)) / kDeg;
+}
+}  // namespace
+
+TEST(CameraHeightScale, AFloorTiltedOffTheTurnAxisByItsRefinementIsRefused)
+{
+	// A mount roll of 3 deg tilts the keyframes' turn axis by atan(0.0560 / 0.9984) = 3.21 deg
+	// (the x axes' common tilt, sin(roll) cos(pitch), over a 90 deg arc).
+	const auto cams = straightPathTurning(24, 45, 135, 3);
+	const CameraHeightScaleEstimator est(optionsFor(kCameraHeight));
+	// With a level table top, the level floor is 3.2 deg off that axis, within
+	// level_max_tilt_deg (4): taken at the true scale.
+	const auto level = est.estimate(cams, floorAndTiltedTop(0, 3));
+	ASSERT_TRUE(level.ok) << level.message;
+	EXPECT_NEAR(level.scale, 1.0, 0.02);
+	const double axisTiltDeg = angleBetweenDeg(level.turnAxis, Eigen::Vector3d::UnitZ());
+	EXPECT_NEAR(axisTiltDeg, 3.21, 0.05);
+	EXPECT_NEAR(level.floorToTurnAxisDeg, axisTiltDeg, 0.5);
+	// A table top tilted 3 deg about x (perpendicular to the axis' tilt) is within the floor
+	// refinement's refine_tilt_deg (5) of the floor, and four times the floor's points: the
+	// common normal leans towards it, between the floor's and the top's, so it ends more than
+	// 4 deg and at most hypot(3.21, 3) deg off the axis. Refused both times, the second after
+	// the search around the turn axis, whose points alone gave a floor within 4 deg: the scale
+	// it would have given is more than 2 % off.
+	const auto tilted = est.estimate(cams, floorAndTiltedTop(-3, 3));
+	EXPECT_FALSE(tilted.ok);
+	EXPECT_EQ(tilted.failure, CameraHeightScaleFailure::OffTurnAxis) << tilted.message;
+	EXPECT_TRUE(tilted.searchedAroundTurnAxis);
+	EXPECT_GT(tilted.floorToTurnAxisDeg, 4.0);
+	EXPECT_LE(tilted.floorToTurnAxisDeg, std::hypot(axisTiltDeg, 3.0) + 0.1);
+	EXPECT_GT(std::abs(tilted.scale - 1.0), 0.02);
+	EXPECT_NE(tilted.message.find("after its refinement"), std::string::npos) << tilted.message;
+}
+
 TEST(CameraHeightScaleOptions, IniRoundTripAndValidation)
 {
 	CameraHeightScaleOptions o;

@@ -182,6 +182,8 @@ TEST(LocalBundleAdjuster, RecoversTheSceneWithEverySolverAndJacobian)
 			o.iterations = 30;
 			o.bf = 40.0;
 			const auto rep = localBundleAdjustment(s.map, 3, K, o);
+			EXPECT_EQ(rep.dedicatedSolver, solver == BaLinearSolver::Dedicated || (solver == BaLinearSolver::Auto && analytic))
+				<< "solver " << int(solver) << " analytic " << analytic;
 			EXPECT_EQ(rep.keyframes, 4);
 			EXPECT_EQ(rep.landmarks, 80);
 			EXPECT_EQ(rep.observations, 320);
@@ -200,6 +202,25 @@ TEST(LocalBundleAdjuster, RecoversTheSceneWithEverySolverAndJacobian)
 		}
 	// Analytic and autodiff Jacobians, any linear solver: the same optimum.
 	for (const auto& r : results) EXPECT_LT((r - results.front()).translation().norm(), 1e-6);
+}
+
+TEST(LocalBundleAdjuster, AutoKeepsCeresForAWindowWithoutDepth)
+{
+	// The same window with every depth beyond max_depth_for_rgbd (the points are 1.6-2.8 m
+	// away): all of it monocular, so `auto` solves it with Ceres' dense Schur, `dedicated` not.
+	for (const auto solver : {BaLinearSolver::Auto, BaLinearSolver::Dedicated})
+	{
+		Scene s;
+		buildScene(s, 0.01, 0.02);
+		BundleAdjusterOptions o;
+		o.linearSolver = solver;
+		o.maxDepthForRgbd = 1.0;
+		o.bf = 40.0;
+		const auto rep = localBundleAdjustment(s.map, 3, K, o);
+		EXPECT_EQ(rep.observations, 320);
+		EXPECT_EQ(rep.dedicatedSolver, solver == BaLinearSolver::Dedicated) << "solver " << int(solver);
+		EXPECT_LT(rep.finalCost, rep.initialCost);
+	}
 }
 
 TEST(LocalBundleAdjuster, FunctionToleranceEndsTheSolveOnceAnIterationGainsLittle)

@@ -293,6 +293,7 @@ BundleAdjustment::BundleAdjustment(
 	const bool depthMeasured = std::any_of(all.begin(), all.end(), [](const Problem::Obs& ob) { return ob.rgbd; });
 	m->dedicated = usesDedicatedSolver(o, local.size(), depthMeasured);
 	if (!m->dedicated) m->buildCeresProblem();
+	rep.dedicatedSolver = m->dedicated;
 	rep.keyframes = static_cast<int>(local.size());
 	rep.fixedKeyFrames = static_cast<int>(fixedSet.size());
 	rep.landmarks = static_cast<int>(m->lms.size());

@@ -85,6 +85,9 @@ struct BundleAdjusterReport
 	/** Landmarks seen by the moving keyframes but left out: no depth and too little parallax
 	 * (BundleAdjusterOptions::minParallaxDegWithoutDepth); they keep their position */
 	int landmarksLeftOut{0};
+	/** Solved by the dedicated sparse solver (BundleLevenbergMarquardt.h), not by Ceres: the
+	 * choice BundleAdjusterOptions::linearSolver made for this problem */
+	bool dedicatedSolver{false};
 	/** Levenberg-Marquardt iterations run (successful and rejected steps) */
 	int iterations{0};
 	double initialCost{0}, finalCost{0};
