@@ -139,9 +139,11 @@ TEST_P(CameraHeightScaleScene, RecoversTheMetricScaleFromTheCameraHeight)
 	// 1 m from the floor points' centroid by 1.7 cm, 1.3 % of the camera's height.
 	EXPECT_GT(r.floorNormal.dot(Q * Eigen::Vector3d::UnitZ()), std::cos(1.0 * M_PI / 180.0));
 	// The simulator's cameras have no roll: every x axis is horizontal, so the turn axis is the
-	// world's up (to rounding), and both loops turn the camera all the way round.
+	// world's up (to rounding), and both loops turn the camera all the way round: the turn is
+	// the arc the keyframes' headings cover, the circle less its largest gap, which office_loop's
+	// keyframes (50 frames apart) leave at their fastest turn (72 deg).
 	EXPECT_LT((r.turnAxis - Q * Eigen::Vector3d::UnitZ()).norm(), 1e-9);
-	EXPECT_GT(r.turnDeg, 300.0);
+	EXPECT_GT(r.turnDeg, 270.0);
 	EXPECT_LT(r.floorToTurnAxisDeg, 1.0);
 }
 

@@ -508,6 +508,21 @@ TEST(CameraHeightScale, AFloorTiltedOffTheTurnAxisByItsRefinementIsRefused)
 	EXPECT_NE(tilted.message.find("after its refinement"), std::string::npos) << tilted.message;
 }
 
+TEST(CameraHeightScale, TheTurnIsTheArcTheCamerasHeadingsCoverWhicheverWayTheyFace)
+{
+	// Whatever the heading, cameras that all face one way have not turned, and cameras that
+	// turn from yaw to yaw + 10 deg have turned 10 deg (the estimate is refused or not, the turn
+	// is measured before the floor search). The room is the fixture's, under the same path.
+	const auto points = rolledPlane(1500, 0, 5);
+	const CameraHeightScaleEstimator est(optionsFor(kCameraHeight));
+	for (int yaw = 0; yaw < 360; yaw += 15)
+	{
+		EXPECT_NEAR(est.estimate(straightPathTurning(24, yaw, yaw, 0), points).turnDeg, 0.0, 1e-6) << "yaw " << yaw;
+		EXPECT_NEAR(est.estimate(straightPathTurning(24, yaw, yaw + 10, 0), points).turnDeg, 10.0, 1e-6) << "yaw " << yaw;
+		EXPECT_NEAR(est.estimate(straightPathTurning(24, yaw, yaw + 300, 0), points).turnDeg, 300.0, 1e-6) << "yaw " << yaw;
+	}
+}
+
 TEST(CameraHeightScaleOptions, IniRoundTripAndValidation)
 {
 	CameraHeightScaleOptions o;

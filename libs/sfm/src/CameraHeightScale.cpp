@@ -161,14 +161,17 @@ TurnAxis turnAxisOf(const std::vector<Eigen::Vector3d>& xAxes, const Eigen::Vect
 	const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);  // eigenvalues ascending
 	t.axis = eig.eigenvectors().col(0).normalized();
 	if (t.axis.dot(up) < 0) t.axis = -t.axis;
+	// The turn is the arc the x axes' headings about the axis cover: the full circle less the
+	// largest gap between neighbouring headings (the eigenvectors' signs are arbitrary, so the
+	// headings may straddle +-pi however little the cameras turned).
 	const Eigen::Vector3d ref = eig.eigenvectors().col(2), side = t.axis.cross(ref);
-	double lo = 0, hi = 0;
-	for (const auto& x : xAxes)
-	{
-		const double a = std::atan2(x.dot(side), x.dot(ref));
-		lo = std::min(lo, a), hi = std::max(hi, a);
-	}
-	t.turnDeg = (hi - lo) * 180.0 / M_PI;
+	std::vector<double> heading;
+	heading.reserve(xAxes.size());
+	for (const auto& x : xAxes) heading.push_back(std::atan2(x.dot(side), x.dot(ref)));
+	std::sort(heading.begin(), heading.end());
+	double largestGap = heading.front() + 2 * M_PI - heading.back();
+	for (std::size_t k = 1; k < heading.size(); k++) largestGap = std::max(largestGap, heading[k] - heading[k - 1]);
+	t.turnDeg = (2 * M_PI - largestGap) * 180.0 / M_PI;
 	return t;
 }
 

@@ -39,8 +39,8 @@ constexpr std::size_t kAutoDenseMaxKeyFrames = 60;
  * reaches the optimum Ceres' Schur solvers reach, without their problem building and
  * preprocessing, which dominate on a local window. A monocular window (no depth) keeps Ceres'
  * dense Schur: with the dedicated solver, monocular runs of a validation scene ended off in
- * scale more often (doc/frontend.md, "Local mapping cost"; the likely reason: such a window's
- * scale is held by its fixed keyframes alone, a weak direction the solvers' rounding moves). */
+ * scale more often, though window by window both solvers reach the same optimum (doc/frontend.md,
+ * "Local mapping cost"): not adopted until more runs say whether that was chance. */
 bool usesDedicatedSolver(const BundleAdjusterOptions& o, std::size_t movingKeyFrames, bool depthMeasured)
 {
 	if (o.linearSolver == BaLinearSolver::Dedicated) return true;

@@ -17,7 +17,7 @@ core::OptionFields MetricScaleOptions::fields()
 {
 	core::OptionFields f = estimator.fields();
 	f.add("min_point_parallax_deg", minPointParallaxDeg, "map points seen under rays less far apart are left out of the floor search [deg]; 0 = all", core::OptionRule::fromBelow(0, 90));
-	f.add("window_max_below_share", windowMaxBelowShare, "the floor search along the newest stretch takes a plane with up to this x its least support of points under it", core::OptionRule::atLeast(0));
+	f.add("window_max_below_share", windowMaxBelowShare, "once the map is metric, the floor search along the newest stretch (and, when the stricter bound finds no clear floor, over the whole map) takes a plane with up to this x its least support of points under it", core::OptionRule::atLeast(0));
 	f.add("window_path_length", windowPathLength, "once metric, the floor is searched along this much of the newest path [m]; 0 = whole map", core::OptionRule::atLeast(0));
 	f.add("path_floor_max_rms", pathFloorMaxRms, "the maps' floor is the plane through the keyframe centres, camera_height under it, when they lie this close to one plane [m]; 0 = the floor points' plane", core::OptionRule::atLeast(0));
 	f.add("path_floor_min_spread", pathFloorMinSpread, "... and when the path spreads this far across its main direction [m]", core::OptionRule::atLeast(0));
@@ -193,6 +193,17 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 	bool wholeMap = window.size() == map.numKeyFrames();
 	std::size_t pointsSearched = 0;
 	auto r = estimateOver(map, window, wholeMap ? m_estimator : m_windowEstimator, &pointsSearched);
+	if (!r.ok && wholeMap && metric() && r.failure == sfm::CameraHeightScaleFailure::FloorNotClear)
+	{
+		// A metric map whose path is still shorter than the window: its floor with the stray
+		// points under it that the newest stretch's search tolerates.
+		auto generous = estimateOver(map, window, m_windowEstimator);
+		if (generous.ok)
+		{
+			generous.message = "with window_max_below_share (" + r.message + "): " + generous.message;
+			r = std::move(generous);
+		}
+	}
 	if (r.ok && !wholeMap && m_opts.windowMaxChange > 0 && std::abs(r.scale - 1) > m_opts.windowMaxChange)
 	{
 		// Too large a change for a drift. Unless the whole map says the same (its scale was off

@@ -165,7 +165,8 @@ struct CameraHeightScaleResult
 	std::size_t parallelPlanes{0}, verticalPlanes{0};
 	int passes{0};  //!< plane searches run (each on the map rescaled by the previous scale)
 	/** The turn axis in the map's frame (unit, towards the cameras' mean -y) and how far the
-	 * keyframes' x axes turned about it [deg]; zero with fewer than two keyframes */
+	 * keyframes' x axes turned about it [deg]: the arc their headings cover, 360 deg less the
+	 * largest gap between neighbouring headings; zero with fewer than two keyframes */
 	Eigen::Vector3d turnAxis{Eigen::Vector3d::Zero()};
 	double turnDeg{0};
 	/** The floor was searched for around the turn axis: the keyframes turned levelMinTurnDeg

@@ -46,12 +46,14 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	 * the whole map (its units are not metres yet); 0 = always the whole map (Default: 8 m) */
 	double windowPathLength{8.0};
 	/** The floor search along the newest stretch of path (a metric map longer than the window)
-	 * takes a plane with up to this x its least support of points under it, where the other
-	 * searches take max_below_share: along a long path a monocular map keeps a few per cent of
-	 * stray points under its floor, and the stricter bound refuses most windows (a desk top is
-	 * still refused: the points under it form a plane of their own,
-	 * maps::estimateLowestFloorPlane). The map's first estimates, on a few keyframes whose scale
-	 * is not known yet, keep the stricter bound (Default: 3) */
+	 * takes a plane with up to this x its least support of points under it, where the searches
+	 * over the whole map take max_below_share: along a long path a monocular map keeps a few
+	 * per cent of stray points under its floor, and the stricter bound refuses most windows (a
+	 * desk top is still refused: the points under it form a plane of their own,
+	 * maps::estimateLowestFloorPlane). A metric map whose path is still shorter than the window
+	 * is searched with the stricter bound first and, when that finds no clear floor, with this
+	 * one. The map's first estimate, on keyframes whose scale is not known yet, keeps the
+	 * stricter bound (Default: 3) */
 	double windowMaxBelowShare{3.0};
 	/** The maps' floor (floorPlane()) is the plane through the keyframe centres, camera_height
 	 * under it, when the centres lie this close to one plane (RMS distance) [m]: a camera at a
