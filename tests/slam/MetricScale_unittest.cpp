@@ -381,6 +381,33 @@ TEST(MetricScale, AfterTheFirstEstimateTheNewestStretchOfThePathIsMeasuredAndRes
 	}
 }
 
+namespace
+{
+/** Keyframes 0.5 map units apart along x at the camera height, looking along x, and the floor
+ * ahead of each pair (400 points seen by both); a share of the points lies 0.2-1 units under it. */
+struct StraightPath
+{
+	explicit StraightPath(sfm::SparseMap& m) : map(m) {}
+	void addStretch(int from, int to, double strayShare)
+	{
+		for (int k = from; k < to; k++) ids.push_back(map.addKeyFrame(keyFrame(camera(0.5 * k, 0, kCameraHeight, 0), 400)).id);
+		std::uniform_real_distribution<double> U(0, 1);
+		for (int k = from; k + 1 < to; k += 2)
+		{
+			const double xk = 0.5 * k;
+			for (int i = 0; i < 400; i++)
+			{
+				const double z = U(rng) < strayShare ? -0.2 - 0.8 * U(rng) : 0.0;
+				map.addObservation(map.addLandmark({xk + 1.0 + 3.0 * U(rng), -2.0 + 4.0 * U(rng), z}, ids[k + 1], i), ids[k], i);
+			}
+		}
+	}
+	sfm::SparseMap& map;
+	std::mt19937 rng{4};
+	std::vector<sfm::KeyFrameId> ids;
+};
+}  // namespace
+
 // Along the newest stretch a monocular map keeps stray points under its floor. Here 4 % of the
 // window's points lie 0.2-1 m under it: the stricter max_below_share refuses the floor ("points
 // under every large plane"), window_max_below_share = 3 takes it, and the scale stays exact.
@@ -395,25 +422,10 @@ TEST(MetricScale, TheWindowSearchTakesAFloorWithStrayPointsUnderIt)
 		o.reestimateEvery = 1;
 		o.windowMaxBelowShare = share;
 		slam::MetricScale scale(o);
-		std::mt19937 rng(4);
-		std::vector<sfm::KeyFrameId> ids;
-		const auto addStretch = [&](int from, int to, double strayShare)
-		{
-			for (int k = from; k < to; k++) ids.push_back(map.addKeyFrame(keyFrame(camera(0.5 * k, 0, kCameraHeight, 0), 400)).id);
-			std::uniform_real_distribution<double> U(0, 1);
-			for (int k = from; k + 1 < to; k += 2)
-			{
-				const double xk = 0.5 * k;
-				for (int i = 0; i < 400; i++)
-				{
-					const double z = U(rng) < strayShare ? -0.2 - 0.8 * U(rng) : 0.0;
-					map.addObservation(map.addLandmark({xk + 1.0 + 3.0 * U(rng), -2.0 + 4.0 * U(rng), z}, ids[k + 1], i), ids[k], i);
-				}
-			}
-		};
-		addStretch(0, 30, 0.0);
+		StraightPath path(map);
+		path.addStretch(0, 30, 0.0);
 		ASSERT_TRUE(scale.update(map).has_value()) << scale.stats().lastMessage;
-		addStretch(30, 50, 0.04);
+		path.addStretch(30, 50, 0.04);
 		const auto s = scale.update(map);
 		if (share > 1)
 		{
@@ -444,28 +456,13 @@ TEST(MetricScale, OnceMetricTheWholeMapSearchTakesAFloorWithStrayPointsUnderIt)
 		o.reestimateEvery = 1;
 		o.windowMaxBelowShare = share;
 		slam::MetricScale scale(o);
-		std::mt19937 rng(4);
-		std::vector<sfm::KeyFrameId> ids;
-		const auto addStretch = [&](int from, int to, double strayShare)
-		{
-			for (int k = from; k < to; k++) ids.push_back(map.addKeyFrame(keyFrame(camera(0.5 * k, 0, kCameraHeight, 0), 400)).id);
-			std::uniform_real_distribution<double> U(0, 1);
-			for (int k = from; k + 1 < to; k += 2)
-			{
-				const double xk = 0.5 * k;
-				for (int i = 0; i < 400; i++)
-				{
-					const double z = U(rng) < strayShare ? -0.2 - 0.8 * U(rng) : 0.0;
-					map.addObservation(map.addLandmark({xk + 1.0 + 3.0 * U(rng), -2.0 + 4.0 * U(rng), z}, ids[k + 1], i), ids[k], i);
-				}
-			}
-		};
-		addStretch(0, 30, firstStrayShare);
+		StraightPath path(map);
+		path.addStretch(0, 30, firstStrayShare);
 		const auto first = scale.update(map);
 		std::optional<slam::MetricScale::Rescale> second;
 		if (first)
 		{
-			addStretch(30, 50, 0.04);
+			path.addStretch(30, 50, 0.04);
 			second = scale.update(map);
 		}
 		return std::make_tuple(first, second, scale.stats().lastMessage);
