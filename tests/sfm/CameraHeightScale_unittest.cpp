@@ -4,6 +4,7 @@
 // isotropic Gaussian noise, the whole map then scaled by an unknown factor k and moved by an
 // arbitrary rigid transform. The recovered scale must be 1 / k within a bound derived from the
 // noise; the refusals must name their reason.
+#include <keygrid/core/VectorAngle.h>
 #include <keygrid/sfm/CameraHeightScale.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/math/CMatrixFixed.h>
@@ -471,11 +472,6 @@ std::vector<Eigen::Vector3d> floorAndTiltedTop(double topTiltDeg, unsigned seed)
 	}
 	return pts;
 }
-
-double angleBetweenDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b)
-{
-	return std::atan2(a.cross(b).norm(), a.dot(b)) / kDeg;
-}
 }  // namespace
 
 TEST(CameraHeightScale, AFloorTiltedOffTheTurnAxisByItsRefinementIsRefused)
@@ -489,7 +485,7 @@ TEST(CameraHeightScale, AFloorTiltedOffTheTurnAxisByItsRefinementIsRefused)
 	const auto level = est.estimate(cams, floorAndTiltedTop(0, 3));
 	ASSERT_TRUE(level.ok) << level.message;
 	EXPECT_NEAR(level.scale, 1.0, 0.02);
-	const double axisTiltDeg = angleBetweenDeg(level.turnAxis, Eigen::Vector3d::UnitZ());
+	const double axisTiltDeg = keygrid::core::angleBetween(level.turnAxis, Eigen::Vector3d::UnitZ()) / kDeg;
 	EXPECT_NEAR(axisTiltDeg, 3.21, 0.05);
 	EXPECT_NEAR(level.floorToTurnAxisDeg, axisTiltDeg, 0.5);
 	// A table top tilted 3 deg about x (perpendicular to the axis' tilt) is within the floor
