@@ -492,6 +492,52 @@ TEST(MetricScale, OnceMetricTheWholeMapSearchTakesAFloorWithStrayPointsUnderIt)
 	}
 }
 
+// That repeated search may only correct a drift: its generous bound could take a plane of
+// stray points, so a change beyond window_max_change is left to the strict search. Here the
+// metric map is put off in scale by `off` before the estimate over it.
+TEST(MetricScale, TheRepeatedWholeMapSearchIsBoundByWindowMaxChange)
+{
+	const auto run = [](double off, double maxChange)
+	{
+		sfm::SparseMap map;
+		auto o = options();
+		o.windowPathLength = 100;  // the window is always the whole map
+		o.reestimateEvery = 1;
+		o.windowMaxBelowShare = 3.0;
+		o.windowMaxChange = maxChange;
+		slam::MetricScale scale(o);
+		StraightPath path(map);
+		path.addStretch(0, 30, 0.0);
+		EXPECT_TRUE(scale.update(map).has_value()) << scale.stats().lastMessage;
+		path.addStretch(30, 50, 0.04);
+		map.rescale(off);
+		const auto second = scale.update(map);
+		return std::make_pair(second, scale.stats().lastMessage);
+	};
+	{
+		// A drift of 5 %: taken, back to metres.
+		const auto [s, msg] = run(1.05, 0.1);
+		ASSERT_TRUE(s.has_value()) << msg;
+		EXPECT_TRUE(s->wholeMap());
+		EXPECT_NEAR(s->factor, 1 / 1.05, 1e-6);
+		EXPECT_NE(msg.find("with window_max_below_share (floor not seen"), std::string::npos) << msg;
+	}
+	{
+		// 25 % off: refused, saying why.
+		const auto [s, msg] = run(1.25, 0.1);
+		EXPECT_FALSE(s.has_value());
+		EXPECT_NE(msg.find("with window_max_below_share x0.8"), std::string::npos) << msg;
+		EXPECT_NE(msg.find("exceeds window_max_change = 0.1"), std::string::npos) << msg;
+		EXPECT_NE(msg.find("floor not seen (points under every large plane)"), std::string::npos) << msg;
+	}
+	{
+		// Without the bound, the same search takes the factor.
+		const auto [s, msg] = run(1.25, 0.0);
+		ASSERT_TRUE(s.has_value()) << msg;
+		EXPECT_NEAR(s->factor, 1 / 1.25, 1e-6);
+	}
+}
+
 // A first estimate that was wrong leaves the whole map off in scale; once the map is longer than
 // the window, the newest stretch then asks for a change beyond window_max_change. The estimate
 // over the whole map says the same, so the whole map is rescaled (exactly back to metres), where

@@ -22,7 +22,7 @@ core::OptionFields MetricScaleOptions::fields()
 	f.add("path_floor_max_rms", pathFloorMaxRms, "the maps' floor is the plane through the keyframe centres, camera_height under it, when they lie this close to one plane [m]; 0 = the floor points' plane", core::OptionRule::atLeast(0));
 	f.add("path_floor_min_spread", pathFloorMinSpread, "... and when the path spreads this far across its main direction [m]", core::OptionRule::atLeast(0));
 	f.add("rescale_whole_map", rescaleWholeMap, "every estimate rescales the whole map, not only the newest window_path_length of path");
-	f.add("window_max_change", windowMaxChange, "an estimate along the newest stretch changing the scale by more than this share is refused; 0 = no bound", core::OptionRule::atLeast(0));
+	f.add("window_max_change", windowMaxChange, "an estimate along the newest stretch (or a metric map's whole-map search repeated with window_max_below_share) changing the scale by more than this share is refused; 0 = no bound", core::OptionRule::atLeast(0));
 	f.add("reestimate_every", reestimateEvery, "after the first estimate, estimate and rescale again every this many keyframes", core::OptionRule::positive());
 	return f;
 }
@@ -197,8 +197,14 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 	{
 		// A metric map whose path is still shorter than the window: its floor with the stray
 		// points under it that the newest stretch's search tolerates.
+		// The generous bound lets planes of stray points through, so the retry may only correct
+		// a drift: a larger change is left to the strict search, which can still undo a wrong
+		// first estimate.
 		auto generous = estimateOver(map, window, m_windowEstimator);
-		if (generous.ok)
+		if (generous.ok && m_opts.windowMaxChange > 0 && std::abs(generous.scale - 1) > m_opts.windowMaxChange)
+			r.message = "with window_max_below_share x" + std::to_string(generous.scale) + " exceeds window_max_change = " +
+						std::to_string(m_opts.windowMaxChange) + " (" + r.message + ")";
+		else if (generous.ok)
 		{
 			generous.message = "with window_max_below_share (" + r.message + "): " + generous.message;
 			r = std::move(generous);

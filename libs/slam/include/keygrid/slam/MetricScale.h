@@ -76,8 +76,10 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	 * unless an estimate over the whole map agrees with it (within this share), which then
 	 * rescales the whole map (its scale was off before the stretch too).
 	 * Estimates over the whole map (the first ones) are not bound: a first estimate on a few
-	 * keyframes can be far off, and the next ones must be able to undo it; 0 = no bound
-	 * (Default: 0.1) */
+	 * keyframes can be far off, and the next ones must be able to undo it. The one exception
+	 * is the whole-map search of a metric map repeated with window_max_below_share (its strict
+	 * search found no clear floor): it is bound too, as its generous bound may take a plane of
+	 * stray points; 0 = no bound (Default: 0.1) */
 	double windowMaxChange{0.1};
 
 	bool enabled() const { return estimator.cameraHeight > 0; }
