@@ -406,6 +406,17 @@ struct StraightPath
 	std::mt19937 rng{4};
 	std::vector<sfm::KeyFrameId> ids;
 };
+
+/** Options whose window is always the whole map (window_path_length far above any test path),
+ * estimating at every keyframe, with window_max_below_share `maxBelowShare`. */
+slam::MetricScaleOptions wholeMapWindow(double maxBelowShare)
+{
+	auto o = options();
+	o.windowPathLength = 100;
+	o.reestimateEvery = 1;
+	o.windowMaxBelowShare = maxBelowShare;
+	return o;
+}
 }  // namespace
 
 // Along the newest stretch a monocular map keeps stray points under its floor. Here 4 % of the
@@ -451,11 +462,7 @@ TEST(MetricScale, OnceMetricTheWholeMapSearchTakesAFloorWithStrayPointsUnderIt)
 	const auto run = [](double firstStrayShare, double share)
 	{
 		sfm::SparseMap map;
-		auto o = options();
-		o.windowPathLength = 100;  // the window is always the whole map
-		o.reestimateEvery = 1;
-		o.windowMaxBelowShare = share;
-		slam::MetricScale scale(o);
+		slam::MetricScale scale(wholeMapWindow(share));
 		StraightPath path(map);
 		path.addStretch(0, 30, firstStrayShare);
 		const auto first = scale.update(map);
@@ -500,10 +507,7 @@ TEST(MetricScale, TheRepeatedWholeMapSearchIsBoundByWindowMaxChange)
 	const auto run = [](double off, double maxChange)
 	{
 		sfm::SparseMap map;
-		auto o = options();
-		o.windowPathLength = 100;  // the window is always the whole map
-		o.reestimateEvery = 1;
-		o.windowMaxBelowShare = 3.0;
+		auto o = wholeMapWindow(3.0);
 		o.windowMaxChange = maxChange;
 		slam::MetricScale scale(o);
 		StraightPath path(map);

@@ -196,10 +196,9 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 	if (!r.ok && wholeMap && metric() && r.failure == sfm::CameraHeightScaleFailure::FloorNotClear)
 	{
 		// A metric map whose path is still shorter than the window: its floor with the stray
-		// points under it that the newest stretch's search tolerates.
-		// The generous bound lets planes of stray points through, so the retry may only correct
-		// a drift: a larger change is left to the strict search, which can still undo a wrong
-		// first estimate.
+		// points under it that the newest stretch's search tolerates. That generous bound lets
+		// planes of stray points through, so the retry may only correct a drift: a larger change
+		// is left to the strict search, which can still undo a wrong first estimate.
 		auto generous = estimateOver(map, window, m_windowEstimator);
 		if (generous.ok && m_opts.windowMaxChange > 0 && std::abs(generous.scale - 1) > m_opts.windowMaxChange)
 			r.message = "with window_max_below_share x" + std::to_string(generous.scale) + " exceeds window_max_change = " +
