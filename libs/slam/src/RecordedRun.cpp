@@ -1,7 +1,9 @@
 #include <keygrid/slam/Interrupt.h>
+#include <keygrid/slam/PlaybackSchedule.h>
 #include <keygrid/slam/RecordedRun.h>
 #include <keygrid/slam/System.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <optional>
@@ -14,6 +16,18 @@ namespace
 {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/** Sleeps until `when`, in steps short enough to notice an interruption; false if one came. */
+bool sleepUntil(Clock::time_point when)
+{
+	for (;;)
+	{
+		if (interruptRequested()) return false;
+		const auto now = Clock::now();
+		if (now >= when) return true;
+		std::this_thread::sleep_for(std::min<Clock::duration>(when - now, std::chrono::milliseconds(50)));
+	}
+}
 }  // namespace
 
 /** A decoded frame with its features, and the time each took. */
@@ -22,6 +36,8 @@ struct RecordedFrameLoop::Extracted
 	core::Frame frame;
 	sfm::FrameFeatures features;
 	double loadSeconds{0}, extractSeconds{0};
+	/** When the frame was released to the pipeline (paced playback only). */
+	std::optional<Clock::time_point> released;
 };
 
 RecordedFrameLoop::RecordedFrameLoop(System& sys, core::PrefetchingFrameSource& source, const RecordedLoopOptions& opts)
@@ -65,6 +81,9 @@ void RecordedFrameLoop::produce(core::BoundedQueue<Extracted>& queue)
 		if (!m_source.next(skippedFrame)) break;
 	const auto limitReached = [&](std::size_t n) { return m_opts.maxFrames && n >= m_opts.maxFrames; };
 	std::optional<double> lastStamp;
+	std::optional<PlaybackSchedule> schedule;
+	if (m_opts.playbackRate > 0) schedule.emplace(m_opts.playbackRate);
+	std::optional<Clock::time_point> firstRelease;
 	for (std::size_t n = 0; !limitReached(n) && !interruptRequested();)
 	{
 		Extracted e;
@@ -79,6 +98,14 @@ void RecordedFrameLoop::produce(core::BoundedQueue<Extracted>& queue)
 			continue;
 		}
 		lastStamp = e.frame.timestamp;
+		if (schedule)
+		{
+			const double due = schedule->release(e.frame.timestamp);
+			if (!firstRelease) firstRelease = Clock::now();
+			const auto when = *firstRelease + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due));
+			if (!sleepUntil(when)) break;
+			e.released = Clock::now();
+		}
 		n++;
 		e.loadSeconds = m_source.lastLoadSeconds();
 		const auto t0 = Clock::now();
@@ -101,6 +128,7 @@ void RecordedFrameLoop::consume(core::BoundedQueue<Extracted>& queue, const std:
 		const auto t0 = Clock::now();
 		onFrame(m_sys.processExtracted(e->frame, std::move(e->features)));
 		m_sys.timings().add("track_and_map", since(t0));
+		if (e->released) m_sys.timings().add("frame_latency", since(*e->released));
 	}
 }
 

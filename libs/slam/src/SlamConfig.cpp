@@ -63,6 +63,7 @@ core::OptionFields SlamConfig::fields()
 	f.add("mapping_lag", mappingLag, "threaded: keyframes local mapping may lag behind tracking (0: none)", R::inRange(0, 5));
 	f.add("busy_keyframe_ratio", busyKeyFrameRatio, "threaded, lag > 0: no keyframe while mapping is busy unless tracking < this x reference (0: off)", R::inRange(0, 1));
 	f.add("wait_for_weak_keyframes", waitForWeakKeyFrames, "threaded, lag > 0: after a keyframe inserted while mapping was busy, wait until mapping is done");
+	f.add("playback_rate", playbackRate, "recorded inputs: release frames at their timestamps' pace x this, as a camera (1: as recorded; 0: as fast as processed)", R::inRange(0, 1000));
 	return f;
 }
 

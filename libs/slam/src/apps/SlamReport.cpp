@@ -213,6 +213,8 @@ std::string slamReportJson(const System& sys, const SlamReportInput& in)
 	js["config_set"] = in.options.set.empty() ? Json() : Json(in.options.set);
 	js["mode"] = toString(in.config.mode);
 	js["sensor"] = toString(in.config.sensor);
+	// Recorded inputs: the pace the frames were released at (0: as fast as processed).
+	js["playback_rate"] = in.live ? Json() : Json(in.config.playbackRate);
 	addScale(js, sys, in.config);
 	addTracking(js, sys, in);
 	addMap(js, sys, in);

@@ -155,7 +155,7 @@ TimestampSkips processFrames(
 		bar.update(st.frames, extra);
 	};
 	std::optional<RecordedFrameLoop> recordedLoop;
-	if (in.recorded) recordedLoop.emplace(sys, *in.recorded, RecordedLoopOptions{o.firstFrame, o.maxFrames});
+	if (in.recorded) recordedLoop.emplace(sys, *in.recorded, RecordedLoopOptions{o.firstFrame, o.maxFrames, cfg.playbackRate});
 	try
 	{
 		if (in.live)

@@ -23,6 +23,10 @@ struct RecordedLoopOptions
 	std::size_t firstFrame{0};
 	/** Stop after this many processed frames (Default: 0 = all) */
 	std::size_t maxFrames{0};
+	/** > 0: frames are released at their timestamps' pace times this factor, as a camera
+	 * delivers them (PlaybackSchedule); 0: as fast as the pipeline takes them ([slam]
+	 * playback_rate) (Default: 0) */
+	double playbackRate{0.0};
 };
 
 /** Frames dropped for their timestamps: a frame without one, or not after the previous
@@ -41,7 +45,8 @@ class RecordedFrameLoop
 
 	/** Runs the frames of the source through the System until the source ends, maxFrames or
 	 * interruptRequested(); calls onFrame after each processed frame. Adds the "input_wait",
-	 * "load", "extract" and "track_and_map" stage timings. Rethrows an error of the source, of
+	 * "load", "extract" and "track_and_map" stage timings, and with a playback rate
+	 * "frame_latency" (from a frame's release to its tracked pose). Rethrows an error of the source, of
 	 * feature extraction or of the processing after the frames before it were processed. */
 	void run(const std::function<void(const sfm::TrackedFrame&)>& onFrame);
 
@@ -53,8 +58,8 @@ class RecordedFrameLoop
 	struct Extracted;
 
 	/** The producer thread's work: skips the first frames, drops frames whose time does not go
-	 * forward, extracts features and pushes the frames until the end, the frame limit, an
-	 * interruption or a closed queue. */
+	 * forward, waits for each frame's release (playbackRate), extracts features and pushes the
+	 * frames until the end, the frame limit, an interruption or a closed queue. */
 	void produce(core::BoundedQueue<Extracted>& queue);
 	/** The calling thread's work: tracks and maps each extracted frame in order. */
 	void consume(core::BoundedQueue<Extracted>& queue, const std::function<void(const sfm::TrackedFrame&)>& onFrame);

@@ -124,6 +124,12 @@ struct SlamConfig
 	 * instead of running ahead of them. Monocular mode takes [monocular]
 	 * wait_for_weak_keyframes instead. (Default: false) */
 	bool waitForWeakKeyFrames{false};
+	/** Recorded inputs: > 0 releases the frames at the pace of their timestamps times this
+	 * factor, as a camera delivers them (1: the recording's own rate; a gap counts for at most
+	 * 1 s), so that a threaded run has the time budget of a live camera; none is dropped.
+	 * 0: as fast as the pipeline takes them. The trajectory of a sequential run does not
+	 * depend on it. (Default: 0) */
+	double playbackRate{0.0};
 	/** Whether tracking waits after a keyframe inserted while local mapping was busy:
 	 * wait_for_weak_keyframes, in monocular mode [monocular] wait_for_weak_keyframes; false
 	 * when no keyframe is deferred (deferralRatio() 0). */
@@ -143,7 +149,8 @@ struct SlamConfig
 	/** Monocular: metric scale from camera_height ([camera_height_scale]; 0 = none). */
 	MetricScaleOptions metricScale;
 
-	/** The [slam] keys (mode, sensor, camera, mapping_lag, busy_keyframe_ratio). */
+	/** The [slam] keys (mode, sensor, camera, mapping_lag, busy_keyframe_ratio,
+	 * wait_for_weak_keyframes, playback_rate). */
 	core::OptionFields fields();
 	void loadFromConfigFile(const mrpt::config::CConfigFileBase& cfg);
 	void saveToConfigFile(mrpt::config::CConfigFileBase& cfg) const;
