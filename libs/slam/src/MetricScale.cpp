@@ -23,6 +23,7 @@ core::OptionFields MetricScaleOptions::fields()
 	f.add("path_floor_min_spread", pathFloorMinSpread, "... and when the path spreads this far across its main direction [m]", core::OptionRule::atLeast(0));
 	f.add("rescale_whole_map", rescaleWholeMap, "every estimate rescales the whole map, not only the newest window_path_length of path");
 	f.add("window_max_change", windowMaxChange, "an estimate along the newest stretch (or a metric map's whole-map search repeated with window_max_below_share) changing the scale by more than this share is refused; 0 = no bound", core::OptionRule::atLeast(0));
+	f.add("window_persistent_shrink", windowPersistentShrink, "a refused change shrinking the map (floor farther below than camera_height) is taken when this many consecutive estimates agree on it within window_max_change / 2; 0 = never", core::OptionRule::atLeast(0));
 	f.add("reestimate_every", reestimateEvery, "after the first estimate, estimate and rescale again every this many keyframes", core::OptionRule::positive());
 	return f;
 }
@@ -175,6 +176,19 @@ sfm::CameraHeightScaleResult MetricScale::estimateOver(
 	return r;
 }
 
+bool MetricScale::persistentShrink(double f) const
+{
+	const auto k = static_cast<std::size_t>(m_opts.windowPersistentShrink);
+	if (k == 0 || !(f < 1) || m_refusedShrinks.size() + 1 < k) return false;
+	double lo = std::log(f), hi = lo;
+	for (auto it = m_refusedShrinks.end() - static_cast<std::ptrdiff_t>(k - 1); it != m_refusedShrinks.end(); ++it)
+	{
+		lo = std::min(lo, std::log(*it));
+		hi = std::max(hi, std::log(*it));
+	}
+	return hi - lo <= 0.5 * m_opts.windowMaxChange;
+}
+
 MetricScale::MetricScale(const MetricScaleOptions& opts)
 	: m_opts(opts), m_estimator(opts.estimator), m_windowEstimator(withMaxBelowShare(opts.estimator, opts.windowMaxBelowShare))
 {
@@ -209,11 +223,13 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 			r = std::move(generous);
 		}
 	}
+	bool refusedByBound = false, refusedShrink = false;
 	if (r.ok && !wholeMap && m_opts.windowMaxChange > 0 && std::abs(r.scale - 1) > m_opts.windowMaxChange)
 	{
 		// Too large a change for a drift. Unless the whole map says the same (its scale was off
 		// before the stretch too: a first estimate that took another plane for the floor), it
-		// comes from a plane above the floor and is refused.
+		// comes from a plane above the floor and is refused; a shrink that persists over
+		// consecutive estimates is a drift (windowPersistentShrink).
 		const auto whole = estimateOver(map, estimateWindow(map, 0.0), m_estimator);
 		if (whole.ok && std::abs(whole.scale - 1) > m_opts.windowMaxChange &&
 			std::abs(std::log(whole.scale / r.scale)) < m_opts.windowMaxChange)
@@ -222,14 +238,27 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 			r.message = "the whole map agrees with the newest stretch's x" + std::to_string(r.scale) + "; " + r.message;
 			wholeMap = true;
 		}
+		else if (persistentShrink(r.scale))
+		{
+			r.message = "x" + std::to_string(r.scale) + " along the newest stretch, refused " + std::to_string(m_refusedShrinks.size()) +
+						" times in a row before within window_max_change / 2 (the floor lies farther below than camera_height: the map grew), and the whole map " +
+						(whole.ok ? "says x" + std::to_string(whole.scale) : "gives no estimate") + "; " + r.message;
+		}
 		else
 		{
+			refusedByBound = true;
+			refusedShrink = r.scale < 1;
+			if (refusedShrink) m_refusedShrinks.push_back(r.scale);
 			r.ok = false;
 			r.message = "refused: a change of x" + std::to_string(r.scale) + " along the newest stretch exceeds window_max_change = " +
 						std::to_string(m_opts.windowMaxChange) + " and the whole map " +
-						(whole.ok ? "says x" + std::to_string(whole.scale) : "gives no estimate") + " (a plane above the floor?); " + r.message;
+						(whole.ok ? "says x" + std::to_string(whole.scale) : "gives no estimate") +
+						(r.scale < 1 ? " (" + std::to_string(m_refusedShrinks.size()) + " in a row)" : " (a plane above the floor?)") + "; " + r.message;
 		}
 	}
+	// A failed estimate says nothing about the drift; any other outcome ends a run of refusals.
+	if (r.ok || (refusedByBound && !refusedShrink)) m_refusedShrinks.clear();
+
 	m_stats.estimates++;
 	m_stats.lastMessage = r.message;
 	std::string floorSource;

@@ -79,8 +79,16 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	 * keyframes can be far off, and the next ones must be able to undo it. The one exception
 	 * is the whole-map search of a metric map repeated with window_max_below_share (its strict
 	 * search found no clear floor): it is bound too, as its generous bound may take a plane of
-	 * stray points; 0 = no bound (Default: 0.1) */
+	 * stray points. A persistent shrink is taken after all (windowPersistentShrink); 0 = no
+	 * bound (Default: 0.1) */
 	double windowMaxChange{0.1};
+	/** A refused change that makes the map smaller (factor below 1 - window_max_change: the
+	 * floor found farther below the cameras than camera_height, which no plane above the floor
+	 * can cause: the map grew) is taken when this many consecutive estimates
+	 * along the newest stretch, this one included, were refused for it and agree within
+	 * window_max_change / 2 (their largest and smallest factor): a drift the whole map cannot
+	 * confirm, its earlier part being at another scale. 0 = never (Default: 3) */
+	int windowPersistentShrink{3};
 
 	bool enabled() const { return estimator.cameraHeight > 0; }
 	core::OptionFields fields();
@@ -154,6 +162,10 @@ class MetricScale
 		const sfm::SparseMap& map, const std::vector<sfm::KeyFrameId>& keyframes,
 		const sfm::CameraHeightScaleEstimator& estimator, std::size_t* pointsSearched = nullptr) const;
 
+	/** A window estimate `f` that window_max_change refuses as a shrink is taken: the
+	 * windowPersistentShrink - 1 refusals before it and f agree within window_max_change / 2. */
+	bool persistentShrink(double f) const;
+
 	MetricScaleOptions m_opts;
 	sfm::CameraHeightScaleEstimator m_estimator;
 	sfm::CameraHeightScaleEstimator m_windowEstimator;  //!< with windowMaxBelowShare
@@ -162,6 +174,10 @@ class MetricScale
 	Stats m_stats;
 	std::optional<FloorPlane> m_floorPlane;  //!< see floorPlane()
 	std::vector<std::string> m_log;  //!< see log()
+	/** The factors of the consecutive estimates refused for shrinking the map beyond
+	 * window_max_change, oldest first (see windowPersistentShrink); cleared by any other
+	 * outcome of an estimate but a failed one. */
+	std::vector<double> m_refusedShrinks;
 };
 
 }  // namespace keygrid::slam
