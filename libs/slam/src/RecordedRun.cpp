@@ -36,7 +36,7 @@ struct RecordedFrameLoop::Extracted
 	core::Frame frame;
 	sfm::FrameFeatures features;
 	double loadSeconds{0}, extractSeconds{0};
-	/** When the frame was released to the pipeline (paced playback only). */
+	/** When the frame was due for release (paced playback only): as a camera delivers it. */
 	std::optional<Clock::time_point> released;
 };
 
@@ -104,7 +104,9 @@ void RecordedFrameLoop::produce(core::BoundedQueue<Extracted>& queue)
 			if (!firstRelease) firstRelease = Clock::now();
 			const auto when = *firstRelease + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due));
 			if (!sleepUntil(when)) break;
-			e.released = Clock::now();
+			// A camera delivers the frame at its time even when the pipeline is behind (the
+			// queue was full): latency counts from then.
+			e.released = when;
 		}
 		n++;
 		e.loadSeconds = m_source.lastLoadSeconds();

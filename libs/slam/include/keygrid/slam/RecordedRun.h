@@ -46,7 +46,7 @@ class RecordedFrameLoop
 	/** Runs the frames of the source through the System until the source ends, maxFrames or
 	 * interruptRequested(); calls onFrame after each processed frame. Adds the "input_wait",
 	 * "load", "extract" and "track_and_map" stage timings, and with a playback rate
-	 * "frame_latency" (from a frame's release to its tracked pose). Rethrows an error of the source, of
+	 * "frame_latency" (from the time a frame is due to its tracked pose). Rethrows an error of the source, of
 	 * feature extraction or of the processing after the frames before it were processed. */
 	void run(const std::function<void(const sfm::TrackedFrame&)>& onFrame);
 
