@@ -7,7 +7,8 @@
 // to the measurement. On a path that stops short of its start no loop may be claimed.
 // Monocular: the keyframes also drift in scale (each keyframe's part of the map is a similarity
 // of the truth) and carry no depth; the loop must be measured as a similarity and the
-// correction must take the scale drift out.
+// correction must take the scale drift out. When the best-scoring candidate has lost its
+// landmarks, the next consistent candidate must close the loop.
 #include <keygrid/sfm/Tracker.h>
 #include <keygrid/loop/LoopCloser.h>
 
@@ -121,6 +122,14 @@ class LoopRun
 		loop::LoopClosureEvent event;
 		CPose3D T_loop_cur_before, T_loop_cur_after, T_first_cur_before, T_first_cur_after;
 	};
+
+	/** Takes every landmark off keyframe kf (its features stay, and so does its BoW entry), as
+	 * culling and fusion can leave an old keyframe: verification against it finds no matches. */
+	void eraseObservationsOf(sfm::KeyFrameId kf)
+	{
+		for (const auto l : std::vector<sfm::LandmarkId>(m_map.keyframe(kf).landmarks))
+			if (l != sfm::kNoLandmark && m_map.hasLandmark(l)) m_map.eraseObservation(l, kf);
+	}
 
 	const loop::LoopCloser& loopCloser() const { return m_loop; }
 	const std::vector<Closure>& closures() const { return m_closures; }
@@ -310,4 +319,45 @@ TEST(LoopCloser, MonocularLoopMeasuresTheScaleDriftAndCorrectsIt)
 	for (const auto& [id, T] : ev.newPoses) EXPECT_EQ(ev.newScales.count(id), 1u) << "keyframe " << id;
 	EXPECT_NEAR(ev.newScales.at(0), 1.0, 1e-12);
 	EXPECT_DOUBLE_EQ(ev.newScales.at(ev.keyframe), ev.scaleCorrection);
+}
+
+TEST(LoopCloser, MonocularLoopIsVerifiedAgainstTheNextCandidateWhenTheBestHasNoLandmarks)
+{
+	// The loop as found on an intact map: the query keyframe that closes it and its loop keyframe.
+	LoopRun intact(1, Sensor::Monocular);
+	for (std::size_t k = 0; k < kKeyFramesWithLoop; k++) intact.addKeyFrame(k);
+	ASSERT_FALSE(intact.closures().empty());
+	const sfm::KeyFrameId closing = intact.closures().front().event.keyframe, loopKf = intact.closures().front().event.loopKeyFrame;
+	const auto closedAt = [](const LoopRun& run, sfm::KeyFrameId kf)
+	{
+		for (const auto& q : run.loopCloser().queries())
+			if (q.keyframe == kf) return q;
+		return loop::LoopQueryRecord{};
+	};
+	EXPECT_EQ(closedAt(intact, closing).verifiedCount, 1) << "the best consistent candidate verified at once";
+
+	// The same run with the loop keyframe's landmarks taken off once it has left the local map:
+	// it still scores best in the database, but has nothing to match. The next consistent
+	// candidate must close the loop, within a keyframe of the intact run (the next-best keyframe
+	// may share too little of the view at the first query).
+	LoopRun stripped(1, Sensor::Monocular);
+	for (std::size_t k = 0; k < kKeyFramesWithLoop; k++)
+	{
+		stripped.addKeyFrame(k);
+		if (k == loopKf + kLocalMapKeyFrames + 1) stripped.eraseObservationsOf(loopKf);
+	}
+	ASSERT_FALSE(stripped.closures().empty());
+	const auto& ev = stripped.closures().front().event;
+	EXPECT_LE(ev.keyframe, closing + 1);
+	EXPECT_NE(ev.loopKeyFrame, loopKf);
+	const auto q = closedAt(stripped, ev.keyframe);
+	EXPECT_EQ(q.outcome, loop::LoopQueryOutcome::Closed);
+	EXPECT_EQ(q.bestCandidate, loopKf);
+	EXPECT_GE(q.verifiedCount, 2) << "the best candidate failed verification first";
+	ASSERT_TRUE(q.verifiedCandidate.has_value());
+	EXPECT_EQ(*q.verifiedCandidate, ev.loopKeyFrame);
+	EXPECT_GE(q.projectedMatches, loop::LoopClosingOptions().sim3MinMatches);
+	// The measurement is the true relative rotation (0.5 px noise: well under a degree).
+	const CPose3D T_loop_cur_true = groundTruthPose(ev.keyframe) - groundTruthPose(ev.loopKeyFrame);
+	EXPECT_LT(test::rotationAngleDeg(ev.T_loop_cur - T_loop_cur_true), 1.0);
 }

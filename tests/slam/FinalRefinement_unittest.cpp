@@ -110,3 +110,101 @@ TEST(FinalRefinement, FramesConvergeToTheirPoseThroughFusedLandmarksAndTooFewKee
 	const auto none = slam::refineFramePoses(frames, base, map, K, {}, 15, [](const sfm::TrackedFrame&) { return false; });
 	EXPECT_FALSE(none[0].has_value());
 }
+
+TEST(FinalRefinement, ScaleBetweenIsTheSimilarityScaleOfTheKeyFrameCentres)
+{
+	// after = a similarity of before (scale 1.07, a turn, a shift) plus keyframes in one map only.
+	const CPose3D S(0.4, -0.2, 1.0, 0.3, 0.1, -0.2);
+	std::map<sfm::KeyFrameId, CPose3D> before, after;
+	const std::vector<Eigen::Vector3d> centres{{0, 0, 0}, {1, 0.2, 0}, {2, -0.5, 0.3}, {0.5, 1.5, -1}, {-1, 0.3, 2}};
+	for (std::size_t i = 0; i < centres.size(); i++)
+	{
+		const auto& c = centres[i];
+		before[i] = CPose3D(c.x(), c.y(), c.z(), 0.1 * static_cast<double>(i), 0, 0);
+		mrpt::math::TPoint3D p;
+		S.composePoint(1.07 * c.x(), 1.07 * c.y(), 1.07 * c.z(), p.x, p.y, p.z);
+		after[i] = CPose3D(p.x, p.y, p.z, -0.2, 0.05 * static_cast<double>(i), 0);  // orientations do not count
+	}
+	before[10] = CPose3D(50, 0, 0, 0, 0, 0);
+	after[11] = CPose3D(-50, 0, 0, 0, 0, 0);
+	EXPECT_NEAR(slam::scaleBetween(before, after), 1.07, 1e-12);
+	EXPECT_EQ(slam::scaleBetween({{0, CPose3D()}}, {{0, CPose3D(1, 0, 0, 0, 0, 0)}}), 1.0);
+}
+
+namespace
+{
+/** Fills `map` without depth: 4 keyframes 0.3 m apart along x, each seeing the 60 landmarks of a 3 m
+ * wall 4 m ahead at their exact pixels. Then the landmarks are put 5 % farther from the first
+ * keyframe and the other keyframes moved by a few cm, as a drifting map leaves them. */
+void fillDriftedMonocularMap(sfm::SparseMap& map, const sfm::PinholeIntrinsics& K)
+{
+	std::vector<Eigen::Vector3d> wall;
+	for (int i = 0; i < 60; i++) wall.emplace_back(-1.5 + 0.3 * (i % 10), -1.0 + 0.4 * (i / 10), 4.0 + 0.1 * (i % 3));
+	std::vector<sfm::LandmarkId> ids;
+	for (int k = 0; k < 4; k++)
+	{
+		const CPose3D T(0.3 * k, 0, 0, 0, 0, 0);
+		sfm::KeyFrame kf;
+		kf.T_world_cam = T;
+		kf.features.keypoints.resize(wall.size());
+		kf.features.undistorted.resize(wall.size());
+		kf.features.depth.assign(wall.size(), 0.f);
+		kf.features.descriptors = cv::Mat(static_cast<int>(wall.size()), 32, CV_8U, cv::Scalar(0));
+		kf.features.levelScale = {1.0};
+		for (std::size_t i = 0; i < wall.size(); i++)
+		{
+			mrpt::math::TPoint3D pc;
+			T.inverseComposePoint(wall[i].x(), wall[i].y(), wall[i].z(), pc.x, pc.y, pc.z);
+			kf.features.undistorted[i] = {static_cast<float>(K.fx * pc.x / pc.z + K.cx), static_cast<float>(K.fy * pc.y / pc.z + K.cy)};
+			kf.features.keypoints[i].pt = kf.features.undistorted[i];
+		}
+		const auto id = map.addKeyFrame(std::move(kf)).id;
+		for (std::size_t i = 0; i < wall.size(); i++)
+		{
+			if (k == 0)
+				ids.push_back(map.addLandmark(1.05 * wall[i], id, static_cast<int>(i)));
+			else
+				map.addObservation(ids[i], id, static_cast<int>(i));
+		}
+		if (k > 0) map.keyframe(id).T_world_cam = CPose3D(0.3 * k + 0.02 * k, 0.01 * k, -0.03, 0.002 * k, 0, 0);
+	}
+	for (const auto id : ids) map.updateLandmarkStats(id);
+	for (const auto& [id, kf] : map.keyframes()) map.updateCovisibility(id);
+}
+
+std::map<sfm::KeyFrameId, CPose3D> keyFramePoses(const sfm::SparseMap& map)
+{
+	std::map<sfm::KeyFrameId, CPose3D> out;
+	for (const auto& [id, kf] : map.keyframes()) out[id] = kf.T_world_cam;
+	return out;
+}
+}  // namespace
+
+TEST(FinalRefinement, WithoutDepthTheFinalAdjustmentKeepsTheMapsScale)
+{
+	const sfm::PinholeIntrinsics K;
+	slam::RefinementOptions rc;
+	const sfm::LocalMapperOptions mapping;
+	sfm::SparseMap free, held;
+	fillDriftedMonocularMap(free, K);
+	fillDriftedMonocularMap(held, K);
+	const auto before = keyFramePoses(free);
+	const auto rFree = slam::finalBundleAdjustment(free, K, {}, rc, mapping, false);
+	const auto rHeld = slam::finalBundleAdjustment(held, K, {}, rc, mapping, true);
+	// Left alone the adjustment rescales the map (the 5 % between landmarks and keyframes is
+	// reconciled at a scale of its own); held, the keyframes' spread is what it was.
+	const double sFree = slam::scaleBetween(before, keyFramePoses(free));
+	EXPECT_GT(std::abs(sFree - 1.0), 1e-3);
+	EXPECT_EQ(rFree.undoneScale, 1.0);
+	EXPECT_NEAR(rHeld.undoneScale, sFree, 1e-6);
+	EXPECT_NEAR(slam::scaleBetween(before, keyFramePoses(held)), 1.0, 1e-9);
+	// The held map is the free one scaled about the origin (the fixed first keyframe), so
+	// every reprojection is the same.
+	for (const auto& [id, T] : keyFramePoses(held))
+	{
+		const auto& Tf = free.keyframe(id).T_world_cam;
+		EXPECT_LT((T.translation() * sFree - Tf.translation()).norm(), 1e-6) << "keyframe " << id;
+	}
+	for (const auto& [id, lm] : held.landmarks()) EXPECT_LT((lm.p_world * sFree - free.landmark(id).p_world).norm(), 1e-6);
+	EXPECT_EQ(rHeld.report.iterations, rFree.report.iterations);
+}

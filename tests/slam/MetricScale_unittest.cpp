@@ -156,6 +156,52 @@ TEST(MetricScale, EstimatesAgainRightAfterARequest)
 	EXPECT_FALSE(scale.update(map).has_value());
 }
 
+// The final bundle adjustment leaves a monocular map's overall scale free: finalEstimate()
+// measures it once more over the whole map, whenever the last estimate was; a change beyond
+// window_max_change is refused, and a map not metric yet is left alone.
+TEST(MetricScale, TheFinalEstimateRescalesTheWholeAdjustedMap)
+{
+	for (const double grown : {1.04, 0.97, 1.15})
+	{
+		SCOPED_TRACE("map scaled by " + std::to_string(grown));
+		sfm::SparseMap map;
+		slam::MetricScale scale(options());
+		const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2500)).id;
+		addRoom(map, first, map.addKeyFrame(keyFrame(circlePose(6, kHeightMap), 2500)).id);
+		for (int k = 1; k < 12; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
+		EXPECT_FALSE(scale.finalEstimate(map).has_value()) << "not metric yet";
+		EXPECT_EQ(scale.stats().estimates, 0);
+		ASSERT_TRUE(scale.update(map).has_value()) << scale.stats().lastMessage;
+		map.rescale(grown);
+		const auto s = scale.finalEstimate(map);
+		if (std::abs(grown - 1) > options().windowMaxChange)
+		{
+			EXPECT_FALSE(s.has_value());
+			for (const auto& [id, kf] : map.keyframes()) EXPECT_NEAR(kf.T_world_cam.z(), grown * kCameraHeight, 1e-5);
+			continue;
+		}
+		ASSERT_TRUE(s.has_value()) << scale.stats().lastMessage;
+		EXPECT_TRUE(s->wholeMap());
+		EXPECT_NEAR(s->factor, 1.0 / grown, 1e-6);
+		for (const auto& [id, kf] : map.keyframes()) EXPECT_NEAR(kf.T_world_cam.z(), kCameraHeight, 1e-5);
+		ASSERT_TRUE(scale.floorPlane().has_value());
+		EXPECT_NEAR(scale.floorPlane()->offset, 0.0, 1e-5);  // the floor plane is z = 0 again
+		EXPECT_EQ(scale.stats().applied, 2);
+	}
+	// Switched off, nothing is estimated.
+	auto off = options();
+	off.finalEstimate = false;
+	sfm::SparseMap map;
+	slam::MetricScale scale(off);
+	const auto first = map.addKeyFrame(keyFrame(circlePose(0, kHeightMap), 2500)).id;
+	addRoom(map, first, map.addKeyFrame(keyFrame(circlePose(6, kHeightMap), 2500)).id);
+	for (int k = 1; k < 12; k++) map.addKeyFrame(keyFrame(circlePose(k, kHeightMap), 10));
+	ASSERT_TRUE(scale.update(map).has_value());
+	map.rescale(1.04);
+	EXPECT_FALSE(scale.finalEstimate(map).has_value());
+	EXPECT_EQ(scale.stats().estimates, 1);
+}
+
 TEST(MetricScale, IsRetriedAtEveryKeyFrameUntilTheFloorIsFound)
 {
 	sfm::SparseMap map;

@@ -231,7 +231,7 @@ int LoopCloser::rejectedImplausible() const
 		m_queries.begin(), m_queries.end(), [](const LoopQueryRecord& q) { return q.outcome == LoopQueryOutcome::Implausible; }));
 }
 
-std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const BowVector& bow, double& score, LoopQueryRecord& rec)
+std::vector<LoopCloser::ScoredCandidate> LoopCloser::detect(sfm::KeyFrameId kfId, const BowVector& bow, LoopQueryRecord& rec)
 {
 	const auto t0 = std::chrono::steady_clock::now();
 	// Reference: the lowest similarity with the covisible keyframes (ORB-SLAM's normalisation).
@@ -268,13 +268,10 @@ std::optional<sfm::KeyFrameId> LoopCloser::detect(sfm::KeyFrameId kfId, const Bo
 		groups.push_back(g);
 	}
 	const auto consistent = m_consistency.check(groups);
+	std::vector<ScoredCandidate> out;
 	for (const auto& c : cands)
-		if (std::find(consistent.begin(), consistent.end(), c.id) != consistent.end())
-		{
-			score = c.score;
-			return c.id;
-		}
-	return std::nullopt;
+		if (std::find(consistent.begin(), consistent.end(), c.id) != consistent.end()) out.push_back({c.id, c.score});
+	return out;
 }
 
 bool LoopCloser::verify(sfm::KeyFrameId cur, sfm::KeyFrameId cand, const sfm::PinholeIntrinsics& K, Eigen::Isometry3d& T_cand_cur, LoopQueryRecord& rec)
@@ -484,26 +481,47 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 	const auto t0 = std::chrono::steady_clock::now();
 	const BowVector bow = m_vocab.transform(m_map.keyframe(kf).features.descriptors);
 	rec.querySeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-	double score = 0;
 	std::optional<LoopClosureEvent> out;
 	if (m_anyLoop && kf <= m_lastLoopKf + kKeyFramesPausedAfterLoop)
 		rec.outcome = LoopQueryOutcome::AfterLoop;
-	else if (auto cand = detect(kf, bow, score, rec); !cand)
+	else if (const auto cands = detect(kf, bow, rec); cands.empty())
 		rec.outcome = rec.candidates ? LoopQueryOutcome::NotConsistent : LoopQueryOutcome::NoCandidate;
 	else
 	{
-		rec.verifiedCandidate = *cand;
-		Eigen::Isometry3d T_cand_cur = Eigen::Isometry3d::Identity();
-		Sim3 S_cand_cur;
-		if (m_opts.monocular)
+		// Monocular: every consistent candidate is verified, best score first, until one passes
+		// (ORB-SLAM's ComputeSim3): the best-scoring keyframe of a revisited place is not always
+		// the one whose landmarks match, e.g. the map's first keyframe, triangulated over a short
+		// baseline. Its verification matches under the vocabulary's nodes and costs little. With
+		// depth the best candidate only: brute-force matching each of up to kMaxCandidates would
+		// cost several times the rest of loop closing per keyframe. The record keeps the passing
+		// candidate, or the one that matched most.
+		const std::size_t tries = m_opts.monocular ? cands.size() : 1;
+		LoopQueryRecord best = rec;
+		for (std::size_t i = 0; i < tries; i++)
 		{
-			// The rigid part of the similarity places the current camera in the loop
-			// keyframe's frame and units, as T_cand_cur does with depth.
-			if (verifySim3(kf, *cand, K, S_cand_cur, rec) && mergeConfirmed(kf, *cand, S_cand_cur.rigid(), K, rec))
-				out = closeVerifiedLoop(kf, *cand, S_cand_cur.rigid(), frameIndex, score, K, rec, S_cand_cur);
+			const auto& c = cands[i];
+			LoopQueryRecord r = rec;
+			r.verifiedCandidate = c.id;
+			++rec.verifiedCount;
+			Eigen::Isometry3d T_cand_cur = Eigen::Isometry3d::Identity();
+			Sim3 S_cand_cur;
+			// The rigid part of the similarity places the current camera in the loop keyframe's
+			// frame and units, as T_cand_cur does with depth.
+			const bool verified = m_opts.monocular ? verifySim3(kf, c.id, K, S_cand_cur, r) : verify(kf, c.id, K, T_cand_cur, r);
+			if (!verified)  // verification named the outcome
+			{
+				if (!best.verifiedCandidate || r.matches > best.matches) best = r;
+				continue;
+			}
+			best = r;
+			if (m_opts.monocular && mergeConfirmed(kf, c.id, S_cand_cur.rigid(), K, best))
+				out = closeVerifiedLoop(kf, c.id, S_cand_cur.rigid(), frameIndex, c.score, K, best, S_cand_cur);
+			else if (!m_opts.monocular && mergeConfirmed(kf, c.id, T_cand_cur, K, best))
+				out = closeVerifiedLoop(kf, c.id, T_cand_cur, frameIndex, c.score, K, best);
+			break;
 		}
-		else if (verify(kf, *cand, K, T_cand_cur, rec) && mergeConfirmed(kf, *cand, T_cand_cur, K, rec))  // else they named the outcome
-			out = closeVerifiedLoop(kf, *cand, T_cand_cur, frameIndex, score, K, rec);
+		best.verifiedCount = rec.verifiedCount;
+		rec = best;
 		if (out) out->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}
 	m_queries.push_back(rec);

@@ -1,7 +1,10 @@
 #include <keygrid/slam/FinalRefinement.h>
 #include <keygrid/sfm/BundleWindow.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
+#include <cmath>
 #include <future>
 
 namespace keygrid::slam
@@ -18,10 +21,35 @@ std::vector<sfm::KeyFrameId> finalWindowSeeds(const std::vector<loop::LoopClosur
 	return seeds;
 }
 
+double scaleBetween(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& before, const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& after)
+{
+	std::vector<Eigen::Vector3d> a, b;
+	for (const auto& [id, T0] : before)
+		if (const auto it = after.find(id); it != after.end())
+		{
+			a.emplace_back(T0.x(), T0.y(), T0.z());
+			b.emplace_back(it->second.x(), it->second.y(), it->second.z());
+		}
+	if (a.size() < 2) return 1.0;
+	Eigen::Matrix3Xd A(3, a.size()), B(3, b.size());
+	for (std::size_t i = 0; i < a.size(); i++)
+	{
+		A.col(static_cast<Eigen::Index>(i)) = a[i];
+		B.col(static_cast<Eigen::Index>(i)) = b[i];
+	}
+	// Umeyama's similarity B ~ s R A + t: s is the top-left block's column norm.
+	const Eigen::Matrix4d T = Eigen::umeyama(A, B, true);
+	const double s = T.topLeftCorner<3, 3>().col(0).norm();
+	return std::isfinite(s) && s > 0 ? s : 1.0;
+}
+
 FinalBundleAdjustment finalBundleAdjustment(
 	sfm::SparseMap& map, const sfm::PinholeIntrinsics& K, const std::vector<loop::LoopClosureEvent>& loops,
-	const RefinementOptions& rc, const sfm::LocalMapperOptions& mapping)
+	const RefinementOptions& rc, const sfm::LocalMapperOptions& mapping, bool holdScale)
 {
+	std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> before;
+	if (holdScale)
+		for (const auto& [id, kf] : map.keyframes()) before[id] = kf.T_world_cam;
 	auto o = mapping.ba;
 	o.iterations = rc.globalIterations;
 	o.functionTolerance = 1e-6;
@@ -37,6 +65,18 @@ FinalBundleAdjustment finalBundleAdjustment(
 	}
 	else
 		out.report = sfm::globalBundleAdjustment(map, K, o);
+	if (holdScale)
+	{
+		std::map<sfm::KeyFrameId, mrpt::poses::CPose3D> after;
+		for (const auto& [id, kf] : map.keyframes()) after[id] = kf.T_world_cam;
+		const double s = scaleBetween(before, after);
+		if (s != 1.0)
+		{
+			// About the world origin: the reprojection errors stay what the adjustment left.
+			map.rescale(1.0 / s);
+			out.undoneScale = s;
+		}
+	}
 	return out;
 }
 

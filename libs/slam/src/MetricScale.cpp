@@ -24,6 +24,7 @@ core::OptionFields MetricScaleOptions::fields()
 	f.add("rescale_whole_map", rescaleWholeMap, "every estimate rescales the whole map, not only the newest window_path_length of path");
 	f.add("window_max_change", windowMaxChange, "an estimate along the newest stretch (or a metric map's whole-map search repeated with window_max_below_share) changing the scale by more than this share is refused; 0 = no bound", core::OptionRule::atLeast(0));
 	f.add("window_persistent_shrink", windowPersistentShrink, "a refused change shrinking the map (floor farther below than camera_height) is taken when this many consecutive estimates agree on it within window_max_change / 2; 0 = never", core::OptionRule::atLeast(0));
+	f.add("final_estimate", finalEstimate, "after the final bundle adjustment (which leaves a monocular map's scale free), estimate over the whole map once more and rescale it");
 	f.add("reestimate_every", reestimateEvery, "after the first estimate, estimate and rescale again every this many keyframes", core::OptionRule::positive());
 	return f;
 }
@@ -174,6 +175,38 @@ sfm::CameraHeightScaleResult MetricScale::estimateOver(
 	if (!r.ok && points.size() < all.size()) r = estimator.estimate(poses, all);
 	if (pointsSearched) *pointsSearched = all.size();
 	return r;
+}
+
+std::optional<MetricScale::Rescale> MetricScale::finalEstimate(sfm::SparseMap& map)
+{
+	if (!m_opts.finalEstimate || !metric() || map.numKeyFrames() < static_cast<std::size_t>(m_opts.estimator.minKeyframes)) return std::nullopt;
+	const auto all = estimateWindow(map, 0.0);
+	std::size_t pointsSearched = 0;
+	auto r = estimateOver(map, all, m_estimator, &pointsSearched);
+	if (!r.ok) r = estimateOver(map, all, m_windowEstimator);
+	if (r.ok && m_opts.windowMaxChange > 0 && std::abs(r.scale - 1) > m_opts.windowMaxChange)
+	{
+		r.ok = false;
+		r.message = "refused: x" + std::to_string(r.scale) + " exceeds window_max_change; " + r.message;
+	}
+	m_stats.estimates++;
+	m_stats.lastMessage = r.message;
+	std::string floorSource;
+	if (r.ok)
+	{
+		map.rescale(r.scale);
+		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource).value_or(FloorPlane{r.floorNormal, r.floorOffset * r.scale});
+	}
+	if (m_log.size() < kMaxLogLines)
+		m_log.push_back("final map, " + std::to_string(all.size()) + " keyframes, " + std::to_string(pointsSearched) + " points: " +
+						(r.ok ? "x" + std::to_string(r.scale) + " (whole map), " : "") + r.message + (r.ok ? "; " + floorSource : ""));
+	if (!r.ok) return std::nullopt;
+	m_stats.applied++;
+	m_stats.totalFactor *= r.scale;
+	m_stats.lastFactor = r.scale;
+	Rescale applied;
+	applied.factor = r.scale;
+	return applied;
 }
 
 bool MetricScale::persistentShrink(double f) const

@@ -634,7 +634,14 @@ std::optional<std::set<sfm::KeyFrameId>> System::adjustFinalMap()
 	std::optional<std::set<sfm::KeyFrameId>> window;
 	if (m_cfg.refinement.globalBundleAdjustment && m_map.numKeyFrames() > 1 && !m_localizeOnly)
 	{
-		auto ba = finalBundleAdjustment(m_map, *m_K, m_loops, m_cfg.refinement, m_cfg.mapping);
+		auto ba = finalBundleAdjustment(m_map, *m_K, m_loops, m_cfg.refinement, m_cfg.mapping, m_cfg.sensor == Sensor::Monocular);
+		m_finalScaleUndone = ba.undoneScale;
+		// Metres again on the adjusted map (its scale was held, not measured).
+		if (m_metricScale)
+		{
+			std::lock_guard<std::mutex> lock(m_map.mutex());
+			if (const auto r = m_metricScale->finalEstimate(m_map)) followWholeMapRescale(r->factor, nullptr);
+		}
 		m_globalBa = ba.report;
 		window = std::move(ba.window);
 	}

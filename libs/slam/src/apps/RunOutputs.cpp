@@ -62,15 +62,15 @@ std::string framesCsv(const System& sys)
 std::string loopQueriesCsv(const loop::LoopCloser& loop)
 {
 	std::ostringstream csv;
-	csv << "keyframe,frame,outcome,reference_score,candidates,best_candidate,best_score,verified_candidate,matches,inliers,query_ms,seen_through\n";
+	csv << "keyframe,frame,outcome,reference_score,candidates,best_candidate,best_score,verified_candidate,matches,inliers,query_ms,seen_through,verified\n";
 	for (const auto& q : loop.queries())
 	{
 		char line[256];
-		std::snprintf(line, sizeof(line), "%llu,%zu,%s,%.4f,%d,%s,%.4f,%s,%d,%d,%.3f,%.4f\n", static_cast<unsigned long long>(q.keyframe),
+		std::snprintf(line, sizeof(line), "%llu,%zu,%s,%.4f,%d,%s,%.4f,%s,%d,%d,%.3f,%.4f,%d\n", static_cast<unsigned long long>(q.keyframe),
 					  q.frameIndex, toString(q.outcome), q.referenceScore, q.candidates,
 					  q.candidates ? std::to_string(q.bestCandidate).c_str() : "", q.bestScore,
 					  q.verifiedCandidate ? std::to_string(*q.verifiedCandidate).c_str() : "", q.matches, q.inliers,
-					  1e3 * q.querySeconds, q.seenThroughRatio);
+					  1e3 * q.querySeconds, q.seenThroughRatio, q.verifiedCount);
 		csv << line;
 	}
 	return csv.str();

@@ -167,7 +167,8 @@ void addOptimization(Json& js, const System& sys)
 	js["mean_ba_iterations"] = rounded(st.sumBaIterations / kfs, 2);
 	if (const auto& ba = sys.globalBundleAdjustmentReport())
 		js["global_ba"] = {{"keyframes", ba->keyframes},		{"landmarks", ba->landmarks}, {"landmarks_left_out", ba->landmarksLeftOut}, {"observations", ba->observations},
-						   {"outliers", ba->outliersRemoved}, {"iterations", ba->iterations}, {"median_chi2", rounded(ba->medianChi2, 4)}};
+						   {"outliers", ba->outliersRemoved}, {"iterations", ba->iterations}, {"median_chi2", rounded(ba->medianChi2, 4)},
+						   {"scale_undone", rounded(sys.finalScaleUndone(), 6)}};
 	if (const auto& shift = sys.finalMapShift())
 		js["final_map_shift"] = {{"largest_m", rounded(shift->largest, 5)}, {"reanchored", shift->reanchored}};
 }

@@ -153,8 +153,12 @@ struct LoopQueryRecord
 	int candidates{0};  //!< database candidates above that reference
 	sfm::KeyFrameId bestCandidate{0};  //!< valid when candidates > 0
 	double bestScore{0};
-	/** The candidate that passed the consistency check and went to verification */
+	/** A consistent candidate sent to verification: the one that passed it, else the one with
+	 * the most matches (matches, inliers and projectedMatches are its) */
 	std::optional<sfm::KeyFrameId> verifiedCandidate;
+	/** Consistent candidates sent to verification, best score first, until one passed (with
+	 * depth only the best) */
+	int verifiedCount{0};
 	/** Verification: descriptor matches with depth on both sides (monocular: with a landmark on
 	 * both sides), RANSAC inliers */
 	int matches{0}, inliers{0};
@@ -212,8 +216,13 @@ class LoopCloser
 
    private:
 	void trainIfReady();
-	/** The consistent candidate, if any; fills rec's candidate fields. */
-	std::optional<sfm::KeyFrameId> detect(sfm::KeyFrameId kf, const BowVector& bow, double& score, LoopQueryRecord& rec);
+	struct ScoredCandidate
+	{
+		sfm::KeyFrameId id;
+		double score;
+	};
+	/** The consistent candidates, best BoW score first; fills rec's candidate fields. */
+	std::vector<ScoredCandidate> detect(sfm::KeyFrameId kf, const BowVector& bow, LoopQueryRecord& rec);
 	/** True for a loop inside one map; for one between two maps (a merge), true once
 	 * mergeConsistency verified loops in a row agree on where the current map lies (else
 	 * rec.outcome = MergePending). */

@@ -27,16 +27,26 @@ struct FinalBundleAdjustment
 	sfm::BundleAdjusterReport report;
 	/** The keyframes it moved when bounded; nullopt when it moved every keyframe */
 	std::optional<std::set<sfm::KeyFrameId>> window;
+	/** Monocular (holdScale): the factor the adjustment had scaled the map by, undone after it
+	 * (1 when the scale was not held) */
+	double undoneScale{1.0};
 };
+
+/** The scale of the similarity that best maps the keyframe centres of `before` onto those of
+ * `after` (the keyframes in both; Umeyama's least squares); 1 for fewer than two. */
+double scaleBetween(const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& before, const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& after);
 
 /** The final bundle adjustment of a run, in place: every keyframe and landmark (the first
  * keyframe fixed), or in a map of more than rc.globalMaxKeyFrames keyframes the window grown
  * from finalWindowSeeds(). The local windows' options `mapping.ba`, with rc.globalIterations
  * and Ceres' default tolerance (it runs once, to convergence); a landmark without a depth
- * measurement whose rays meet at less than mapping.minParallaxDeg stays out. */
+ * measurement whose rays meet at less than mapping.minParallaxDeg stays out.
+ * holdScale (a map without depth): the reprojection errors do not change when the whole map
+ * is scaled about the fixed keyframe, so the adjustment's own scale is arbitrary: the map's
+ * scale before it (metres from the camera height, or the unit the run kept) is restored. */
 FinalBundleAdjustment finalBundleAdjustment(
 	sfm::SparseMap& map, const sfm::PinholeIntrinsics& K, const std::vector<loop::LoopClosureEvent>& loops,
-	const RefinementOptions& rc, const sfm::LocalMapperOptions& mapping);
+	const RefinementOptions& rc, const sfm::LocalMapperOptions& mapping, bool holdScale = false);
 
 /** Largest displacement [m], over the keyframes of `before` that are in `after`, of the camera
  * centre or of the point `depth` m ahead of it on the optical axis (what a rotation moves in

@@ -89,6 +89,10 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	 * window_max_change / 2 (their largest and smallest factor): a drift the whole map cannot
 	 * confirm, its earlier part being at another scale. 0 = never (Default: 3) */
 	int windowPersistentShrink{3};
+	/** After the run's final bundle adjustment, estimate the scale once more over the whole map
+	 * and rescale it (MetricScale::finalEstimate): that adjustment reshapes the map, and its
+	 * overall scale is free (a map without depth) (Default: true) */
+	bool finalEstimate{true};
 
 	bool enabled() const { return estimator.cameraHeight > 0; }
 	core::OptionFields fields();
@@ -120,6 +124,11 @@ class MetricScale
 	 * or its newest stretch) and says how; nullopt when nothing was applied. The caller holds
 	 * the map's lock. */
 	std::optional<Rescale> update(sfm::SparseMap& map);
+	/** After the run's final bundle adjustment: estimates the scale over the whole map (when
+	 * the strict search finds no clear floor, with window_max_below_share) and rescales the
+	 * whole map when the change is at most window_max_change; nullopt otherwise, and for a map
+	 * not metric yet. The caller holds the map's lock. */
+	std::optional<Rescale> finalEstimate(sfm::SparseMap& map);
 	/** The map's scale changed in places (a Sim(3) loop correction, which keeps the units of the
 	 * map's first keyframe): the next update() estimates, whenever the last estimate was. The
 	 * caller holds the map's lock. */

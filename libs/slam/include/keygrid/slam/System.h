@@ -151,6 +151,9 @@ class System
 	const std::vector<loop::LoopClosureEvent>& loopClosures() const { return m_loops; }
 	/** Report of the final global bundle adjustment (finish()); empty when it did not run. */
 	const std::optional<sfm::BundleAdjusterReport>& globalBundleAdjustmentReport() const { return m_globalBa; }
+	/** Monocular: the scale the final bundle adjustment gave the map, undone after it
+	 * (FinalBundleAdjustment::undoneScale); 1 otherwise */
+	double finalScaleUndone() const { return m_finalScaleUndone; }
 	/** finish(): how far the final refinement moved the keyframes the maps hold (largest move
 	 * of a camera centre or of the point refinement.map_reanchor_depth ahead of it) [m], and
 	 * whether the maps were re-anchored for it (more than refinement.map_reanchor_min_shift). */
@@ -295,6 +298,7 @@ class System
 	std::unique_ptr<loop::LoopCloser> m_loopCloser;
 	std::vector<loop::LoopClosureEvent> m_loops;
 	std::optional<sfm::BundleAdjusterReport> m_globalBa;
+	double m_finalScaleUndone{1.0};  //!< see finalScaleUndone()
 	std::optional<FinalMapShift> m_finalMapShift;
 	double m_travelled{0};
 	std::optional<mrpt::poses::CPose3D> m_lastTrackedPose;
