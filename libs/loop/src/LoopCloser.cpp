@@ -502,25 +502,24 @@ std::optional<LoopClosureEvent> LoopCloser::process(sfm::KeyFrameId kf, std::siz
 			const auto& c = cands[i];
 			LoopQueryRecord r = rec;
 			r.verifiedCandidate = c.id;
-			++rec.verifiedCount;
+			r.verifiedCount = static_cast<int>(i) + 1;
 			Eigen::Isometry3d T_cand_cur = Eigen::Isometry3d::Identity();
 			Sim3 S_cand_cur;
-			// The rigid part of the similarity places the current camera in the loop keyframe's
-			// frame and units, as T_cand_cur does with depth.
 			const bool verified = m_opts.monocular ? verifySim3(kf, c.id, K, S_cand_cur, r) : verify(kf, c.id, K, T_cand_cur, r);
 			if (!verified)  // verification named the outcome
 			{
 				if (!best.verifiedCandidate || r.matches > best.matches) best = r;
+				best.verifiedCount = r.verifiedCount;
 				continue;
 			}
 			best = r;
-			if (m_opts.monocular && mergeConfirmed(kf, c.id, S_cand_cur.rigid(), K, best))
-				out = closeVerifiedLoop(kf, c.id, S_cand_cur.rigid(), frameIndex, c.score, K, best, S_cand_cur);
-			else if (!m_opts.monocular && mergeConfirmed(kf, c.id, T_cand_cur, K, best))
-				out = closeVerifiedLoop(kf, c.id, T_cand_cur, frameIndex, c.score, K, best);
+			// The rigid part of the similarity places the current camera in the loop keyframe's
+			// frame and units, as T_cand_cur does with depth.
+			std::optional<Sim3> S;
+			if (m_opts.monocular) T_cand_cur = (S = S_cand_cur)->rigid();
+			if (mergeConfirmed(kf, c.id, T_cand_cur, K, best)) out = closeVerifiedLoop(kf, c.id, T_cand_cur, frameIndex, c.score, K, best, S);
 			break;
 		}
-		best.verifiedCount = rec.verifiedCount;
 		rec = best;
 		if (out) out->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 	}

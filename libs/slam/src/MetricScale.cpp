@@ -189,23 +189,43 @@ std::optional<MetricScale::Rescale> MetricScale::finalEstimate(sfm::SparseMap& m
 		r.ok = false;
 		r.message = "refused: x" + std::to_string(r.scale) + " exceeds window_max_change; " + r.message;
 	}
+	return conclude(map, r, all, true, "final map, " + std::to_string(all.size()) + " keyframes, " + std::to_string(pointsSearched) + " points: ");
+}
+
+std::optional<MetricScale::Rescale> MetricScale::conclude(
+	sfm::SparseMap& map, const sfm::CameraHeightScaleResult& r, const std::vector<sfm::KeyFrameId>& window, bool wholeMap, const std::string& logHead)
+{
 	m_stats.estimates++;
 	m_stats.lastMessage = r.message;
 	std::string floorSource;
+	Rescale applied;
 	if (r.ok)
 	{
-		map.rescale(r.scale);
-		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource).value_or(FloorPlane{r.floorNormal, r.floorOffset * r.scale});
+		// The whole map while the window is all of it or when asked for; else the window alone.
+		FloorPlane found{r.floorNormal, 0.0};
+		if (wholeMap || m_opts.rescaleWholeMap || window.size() < 2)
+		{
+			map.rescale(r.scale);
+			applied.factor = r.scale;
+			// The plane was found in the map before the rescale: its offset scales with the map.
+			found.offset = r.floorOffset * r.scale;
+		}
+		else
+		{
+			applied = rescaleWindow(map, window, r.scale);
+			// The floor the estimate found, camera_height under the rescaled window.
+			found.offset = m_opts.estimator.cameraHeight - medianHeight(map, window, r.floorNormal);
+		}
+		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource).value_or(found);
 	}
 	if (m_log.size() < kMaxLogLines)
-		m_log.push_back("final map, " + std::to_string(all.size()) + " keyframes, " + std::to_string(pointsSearched) + " points: " +
-						(r.ok ? "x" + std::to_string(r.scale) + " (whole map), " : "") + r.message + (r.ok ? "; " + floorSource : ""));
+		m_log.push_back(
+			logHead + (r.ok ? "x" + std::to_string(r.scale) + (applied.wholeMap() ? " (whole map), " : " (window), ") : "") +
+			r.message + (r.ok ? "; " + floorSource : ""));
 	if (!r.ok) return std::nullopt;
 	m_stats.applied++;
 	m_stats.totalFactor *= r.scale;
 	m_stats.lastFactor = r.scale;
-	Rescale applied;
-	applied.factor = r.scale;
 	return applied;
 }
 
@@ -292,39 +312,7 @@ std::optional<MetricScale::Rescale> MetricScale::update(sfm::SparseMap& map)
 	// A failed estimate says nothing about the drift; any other outcome ends a run of refusals.
 	if (r.ok || (refusedByBound && !refusedShrink)) m_refusedShrinks.clear();
 
-	m_stats.estimates++;
-	m_stats.lastMessage = r.message;
-	std::string floorSource;
-	Rescale applied;
-	if (r.ok)
-	{
-		// The whole map while the window is all of it or when asked for; else the window alone.
-		FloorPlane found{r.floorNormal, 0.0};
-		if (wholeMap || m_opts.rescaleWholeMap || window.size() < 2)
-		{
-			map.rescale(r.scale);
-			applied.factor = r.scale;
-			// The plane was found in the map before the rescale: its offset scales with the map.
-			found.offset = r.floorOffset * r.scale;
-		}
-		else
-		{
-			applied = rescaleWindow(map, window, r.scale);
-			// The floor the estimate found, camera_height under the rescaled window.
-			found.offset = m_opts.estimator.cameraHeight - medianHeight(map, window, r.floorNormal);
-		}
-		m_floorPlane = floorUnderThePath(map, r.floorNormal, m_opts, floorSource).value_or(found);
-	}
-	if (m_log.size() < kMaxLogLines)
-		m_log.push_back(
-			"keyframe " + std::to_string(newest) + ", " + std::to_string(window.size()) + " keyframes, " + std::to_string(pointsSearched) +
-			" points: " + (r.ok ? "x" + std::to_string(r.scale) + (applied.wholeMap() ? " (whole map), " : " (window), ") : "") +
-			r.message + (r.ok ? "; " + floorSource : ""));
-	if (!r.ok) return std::nullopt;
-	m_stats.applied++;
-	m_stats.totalFactor *= r.scale;
-	m_stats.lastFactor = r.scale;
-	return applied;
+	return conclude(map, r, window, wholeMap, "keyframe " + std::to_string(newest) + ", " + std::to_string(window.size()) + " keyframes, " + std::to_string(pointsSearched) + " points: ");
 }
 
 }  // namespace keygrid::slam

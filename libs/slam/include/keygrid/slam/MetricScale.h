@@ -171,6 +171,13 @@ class MetricScale
 		const sfm::SparseMap& map, const std::vector<sfm::KeyFrameId>& keyframes,
 		const sfm::CameraHeightScaleEstimator& estimator, std::size_t* pointsSearched = nullptr) const;
 
+	/** Counts the estimate `r` over `window` (all keyframes when wholeMap) and, when it
+	 * succeeded, applies it (the whole map, or the window alone) and sets the floor plane; logs
+	 * logHead and the result. */
+	std::optional<Rescale> conclude(
+		sfm::SparseMap& map, const sfm::CameraHeightScaleResult& r, const std::vector<sfm::KeyFrameId>& window, bool wholeMap,
+		const std::string& logHead);
+
 	/** A window estimate `f` that window_max_change refuses as a shrink is taken: the
 	 * windowPersistentShrink - 1 refusals before it and f agree within window_max_change / 2. */
 	bool persistentShrink(double f) const;
