@@ -1,7 +1,8 @@
 /** Keyframes without depth (monocular) in the maps: the 3D grid integrates a keyframe's map
  * points (one point straight ahead against the closed form), and a Sim(3) correction, which
  * gives each keyframe its own scale, leaves the 2D grid, the 3D grid and the floor estimate
- * as if they had been built from scratch with the corrected keyframes. */
+ * as if they had been built from scratch with the corrected keyframes; so do map points
+ * re-estimated by a final refinement. */
 #include <keygrid/maps/CISMOccupancyGrid2D.h>
 #include <keygrid/maps/CSubmappedOccupancyGrid3D.h>
 #include <keygrid/maps/FloorFrameEstimator.h>
@@ -234,6 +235,42 @@ TEST(MapPointKeyFrames, A3DGridOfMapPointsFollowsEachKeyFramesScale)
 	EXPECT_TRUE(restored.fusedGrid() == corrected.fusedGrid());
 	EXPECT_GT(differingVoxels(truthGrid, posesOnly.fusedGrid()).first, known / 10);
 	for (const auto& [id, rec] : corrected.keyframes()) EXPECT_TRUE(rec.T_world_cam == run.truth[id]);
+}
+
+/* A final refinement of a map without depth re-estimates the map points, not only the
+ * keyframe poses: given with the correction (MapCorrection::points_world), they replace what
+ * both grids hold of each keyframe. Here the inserted points are the scale-drifted ones and the
+ * correction names the true poses without the scales, with the true points: both grids end as
+ * if built from scratch with them, and without the points they do not. */
+TEST(MapPointKeyFrames, ReEstimatedPointsReplaceTheInsertedOnes)
+{
+	keygrid::test::SyntheticRoom room;
+	const ScaleDriftedRun run(room);
+	maps::MapCorrection refined = run.correction(false);
+	for (std::size_t k = 0; k < run.truth.size(); k++) refined.points_world[k] = run.seenTrue[k];
+	refined.points_world[1000] = run.seenTrue[0];  // a keyframe the grids do not hold: ignored
+
+	CISMOccupancyGrid2D fresh2d = roomGrid2D(), refined2d = roomGrid2D(), posesOnly2d = roomGrid2D();
+	CSubmappedOccupancyGrid3D fresh3d, refined3d;
+	for (auto* g : {&fresh3d, &refined3d}) g->insertionOptions.integration.threads = 2;
+	for (std::size_t k = 0; k < run.truth.size(); k++)
+	{
+		fresh2d.insertKeyFrame(run.keyFrame(k, true), maps::KeyFrameFeed{});
+		fresh3d.insertKeyFrame(run.keyFrame(k, true), maps::KeyFrameFeed{});
+		for (maps::KeyFrameMap* g : std::initializer_list<maps::KeyFrameMap*>{&refined2d, &posesOnly2d, &refined3d})
+			g->insertKeyFrame(run.keyFrame(k, false), maps::KeyFrameFeed{});
+	}
+	EXPECT_TRUE(refined2d.applyCorrection(refined));
+	EXPECT_TRUE(posesOnly2d.applyCorrection(run.correction(false)));
+	EXPECT_TRUE(static_cast<maps::KeyFrameMap&>(refined3d).applyCorrection(refined));
+
+	const std::size_t occupied = fresh2d.countStates()[2];
+	ASSERT_GT(occupied, 300u);
+	EXPECT_EQ(differingCells(fresh2d, refined2d), 0u);
+	EXPECT_GT(differingCells(fresh2d, posesOnly2d), occupied / 4);
+	const auto [differ, known] = differingVoxels(fresh3d.fusedGrid(), refined3d.fusedGrid());
+	ASSERT_GT(known, 20000u);
+	EXPECT_LE(differ, known / 500) << differ << " of " << known;
 }
 
 /* The floor estimate on map points (monocular without a camera height) follows the scales

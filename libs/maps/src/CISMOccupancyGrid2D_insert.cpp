@@ -358,12 +358,7 @@ bool CISMOccupancyGrid2D::insertKeyframePoints(
 {
 	KeyframeRays kf;
 	kf.T_world_cam = T_world_cam;
-	kf.points_cam.reserve(points_world.size());
-	for (const auto& p : points_world)
-	{
-		const TPoint3D pc = T_world_cam.inverseComposePoint(p);
-		kf.points_cam.emplace_back(static_cast<float>(pc.x), static_cast<float>(pc.y), static_cast<float>(pc.z));
-	}
+	kf.points_cam = maps::toCameraFrame(T_world_cam, points_world);
 	m_keyframes[keyframeId] = kf;
 	if (!floorKnown()) return false;
 	integrateRays(kf.T_world_cam, m_keyframes[keyframeId].points_cam);

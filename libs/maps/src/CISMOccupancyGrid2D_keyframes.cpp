@@ -57,6 +57,15 @@ bool CISMOccupancyGrid2D::applyCorrection(const maps::MapCorrection& correction)
 	// A keyframe's own similarity (monocular loop correction): its rays grow with it.
 	for (const auto& [id, c] : correction.poses)
 		if (const auto it = m_keyframes.find(id); c.scale != 1.0 && it != m_keyframes.end()) scaleRays(it->second, c.scale);
+	// Re-estimated map points replace a keyframe's stored rays, in its corrected camera frame.
+	for (const auto& [id, pts] : correction.points_world)
+	{
+		const auto it = m_keyframes.find(id);
+		if (it == m_keyframes.end()) continue;
+		const auto c = correction.poses.find(id);
+		const mrpt::poses::CPose3D& T = c != correction.poses.end() ? c->second.T_world_cam_new : it->second.T_world_cam;
+		it->second.points_cam = maps::toCameraFrame(T, pts);
+	}
 	if (correction.T_world_floor) setExternalFloorPose(*correction.T_world_floor);
 	if (!floorKnown()) return false;  // nothing integrated yet: no floor frame
 	std::map<uint64_t, mrpt::poses::CPose3D> newPoses;

@@ -56,13 +56,8 @@ CSubmappedOccupancyGrid3D::InsertResult CSubmappedOccupancyGrid3D::insertMapPoin
 	k.fromMapPoints = true;
 	std::vector<mrpt::math::TPoint3Df> ends;
 	ends.reserve(points_world.size());
-	k.points_cam.reserve(points_world.size());
-	for (const auto& p : points_world)
-	{
-		ends.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
-		const auto q = T_world_cam.inverseComposePoint(p);
-		k.points_cam.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
-	}
+	for (const auto& p : points_world) ends.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z));
+	k.points_cam = maps::toCameraFrame(T_world_cam, points_world);
 	const FrameVoxelUpdates upd = integrator().castPoints(T_world_cam.translation(), ends, m_resolution);
 	return integrateFrame(upd, travelled, std::move(k));
 }

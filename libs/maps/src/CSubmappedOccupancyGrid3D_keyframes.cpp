@@ -35,7 +35,7 @@ bool CSubmappedOccupancyGrid3D::applyCorrection(const maps::MapCorrection& corre
 	// Map points are kept per keyframe: such a grid is rebuilt from them, in any scale.
 	if (builtFromMapPoints())
 	{
-		rebuildFromMapPoints(correction.poses, correction.scale);
+		rebuildFromMapPoints(correction.poses, correction.scale, correction.points_world);
 		return true;
 	}
 	// Submaps of depth are morphed rigidly; a scale would need their voxels resampled, which

@@ -95,7 +95,8 @@ bool CSubmappedOccupancyGrid3D::builtFromMapPoints() const
 }
 
 CSubmappedOccupancyGrid3D::ReintegrationStats
-	CSubmappedOccupancyGrid3D::rebuildFromMapPoints(const TrajectoryCorrection& corr, double worldScale)
+	CSubmappedOccupancyGrid3D::rebuildFromMapPoints(
+		const TrajectoryCorrection& corr, double worldScale, const std::map<uint64_t, std::vector<mrpt::math::TPoint3D>>& newPoints)
 {
 	if (!builtFromMapPoints())
 		throw std::logic_error("rebuildFromMapPoints: the grid holds keyframes integrated from depth");
@@ -123,6 +124,7 @@ CSubmappedOccupancyGrid3D::ReintegrationStats
 			rec.T_world_cam = it->second.T_world_cam_new;
 			if (it->second.scale != 1.0) scalePoints(rec.points_cam, it->second.scale);
 		}
+		if (const auto it = newPoints.find(id); it != newPoints.end()) rec.points_cam = maps::toCameraFrame(rec.T_world_cam, it->second);
 		ends.clear();
 		for (const auto& p : rec.points_cam)
 		{

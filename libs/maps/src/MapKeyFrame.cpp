@@ -1,5 +1,6 @@
 /** \file MapKeyFrame.cpp
- * MapKeyFrame::depthScan(): the keyframe's depth as a CObservation3DRangeScan.
+ * MapKeyFrame::depthScan(): the keyframe's depth as a CObservation3DRangeScan; map points in
+ * a keyframe's camera frame.
  */
 #include <keygrid/core/FrameConventions.h>
 #include <keygrid/maps/MapKeyFrame.h>
@@ -28,6 +29,19 @@ const mrpt::obs::CObservation3DRangeScan& MapKeyFrame::depthScan() const
 	obs->maxRange = 10.0f;
 	m_depthScan = obs;
 	return *m_depthScan;
+}
+
+std::vector<mrpt::math::TPoint3Df> toCameraFrame(
+	const mrpt::poses::CPose3D& T_world_cam, const std::vector<mrpt::math::TPoint3D>& points_world)
+{
+	std::vector<mrpt::math::TPoint3Df> out;
+	out.reserve(points_world.size());
+	for (const auto& p : points_world)
+	{
+		const auto q = T_world_cam.inverseComposePoint(p);
+		out.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z));
+	}
+	return out;
 }
 
 }  // namespace keygrid::maps

@@ -24,6 +24,7 @@ core::OptionFields MapFeedOptions::fields()
 	core::OptionFields f;
 	f.add("ism2d_input", ism2dInput, "input of the 2D ISM grid: sparse (map points) | dense (depth image)", core::OptionRule::oneOf({"sparse", "dense"}));
 	f.add("sparse_min_parallax_deg", sparseMinParallaxDeg, "the maps take map points without depth only when seen under rays this far apart [deg]; 0 = all", core::OptionRule::fromBelow(0, 90));
+	f.add("refresh_final_points", refreshFinalPoints, "after the final refinement the maps take the map points of keyframes without depth as the refined map holds them (else as when inserted)");
 	return f;
 }
 
@@ -178,6 +179,15 @@ maps::MapKeyFrame MetricMaps::mapKeyFrame(const sfm::SparseMap& map, sfm::KeyFra
 	out.T_world_cam = kf.T_world_cam;
 	out.camera = kf.features.camera;
 	out.depth = depthOf(kf);
+	out.points_world = mapPointsOf(map, id);
+	out.travelled = travelled;
+	return out;
+}
+
+std::vector<mrpt::math::TPoint3D> MetricMaps::mapPointsOf(const sfm::SparseMap& map, sfm::KeyFrameId id) const
+{
+	const auto& kf = map.keyframe(id);
+	std::vector<mrpt::math::TPoint3D> out;
 	const double minCos = std::cos(m_feed.sparseMinParallaxDeg * M_PI / 180.0);
 	for (std::size_t i = 0; i < kf.landmarks.size(); i++)
 	{
@@ -186,9 +196,22 @@ maps::MapKeyFrame MetricMaps::mapKeyFrame(const sfm::SparseMap& map, sfm::KeyFra
 		const auto& lm = map.landmark(l);
 		const bool hasDepth = i < kf.features.depth.size() && kf.features.depth[i] > 0;
 		if (m_feed.sparseMinParallaxDeg > 0 && !hasDepth && !(sfm::largestParallaxCos(map, lm) <= minCos)) continue;
-		out.points_world.emplace_back(lm.p_world.x(), lm.p_world.y(), lm.p_world.z());
+		out.emplace_back(lm.p_world.x(), lm.p_world.y(), lm.p_world.z());
 	}
-	out.travelled = travelled;
+	return out;
+}
+
+std::map<sfm::KeyFrameId, std::vector<mrpt::math::TPoint3D>> MetricMaps::refreshedMapPoints(const sfm::SparseMap& map) const
+{
+	std::map<sfm::KeyFrameId, std::vector<mrpt::math::TPoint3D>> out;
+	if (!m_feed.refreshFinalPoints || empty()) return out;
+	for (const auto& [id, T] : m_insertedPoses)
+	{
+		if (!map.hasKeyFrame(id)) continue;
+		const auto& depth = map.keyframe(id).features.depth;
+		if (std::any_of(depth.begin(), depth.end(), [](float d) { return d > 0; })) continue;
+		out[id] = mapPointsOf(map, id);
+	}
 	return out;
 }
 
@@ -235,7 +258,8 @@ cv::Mat MetricMaps::depthOf(const sfm::KeyFrame& kf) const
 }
 
 std::map<std::string, double> MetricMaps::applyCorrection(
-	const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses, const std::map<sfm::KeyFrameId, double>& newScales)
+	const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses, const std::map<sfm::KeyFrameId, double>& newScales,
+	const std::map<sfm::KeyFrameId, std::vector<mrpt::math::TPoint3D>>& newPoints)
 {
 	for (const auto& [id, s] : newScales)
 		if (!(s > 0) || !std::isfinite(s))
@@ -259,6 +283,8 @@ std::map<std::string, double> MetricMaps::applyCorrection(
 	}
 	for (const auto& [id, T] : newPoses)
 		if (m_insertedPoses.count(id)) correction.poses[id] = PoseCorrection{m_insertedPoses.at(id), T, scaleOf(id)};
+	for (const auto& [id, pts] : newPoints)
+		if (m_insertedPoses.count(id)) correction.points_world[id] = pts;
 	for (const auto& [name, sec] : dispatchCorrection(correction)) out[name] = sec;
 	for (const auto& [id, T] : newPoses)
 		if (m_insertedPoses.count(id)) m_insertedPoses[id] = T;

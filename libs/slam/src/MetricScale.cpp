@@ -24,7 +24,7 @@ core::OptionFields MetricScaleOptions::fields()
 	f.add("rescale_whole_map", rescaleWholeMap, "every estimate rescales the whole map, not only the newest window_path_length of path");
 	f.add("window_max_change", windowMaxChange, "an estimate along the newest stretch (or a metric map's whole-map search repeated with window_max_below_share) changing the scale by more than this share is refused; 0 = no bound", core::OptionRule::atLeast(0));
 	f.add("window_persistent_shrink", windowPersistentShrink, "a refused change shrinking the map (floor farther below than camera_height) is taken when this many consecutive estimates agree on it within window_max_change / 2; 0 = never", core::OptionRule::atLeast(0));
-	f.add("final_estimate", finalEstimate, "after the final bundle adjustment (which leaves a monocular map's scale free), estimate over the whole map once more and rescale it");
+	f.add("final_estimate", finalEstimate, "after the final bundle adjustment (which leaves a monocular map's scale free), estimate the scale once more and rescale the whole map: the median over overlapping stretches of window_path_length when the path is longer than 1.5 of it, else over the whole map");
 	f.add("reestimate_every", reestimateEvery, "after the first estimate, estimate and rescale again every this many keyframes", core::OptionRule::positive());
 	return f;
 }
@@ -55,6 +55,40 @@ std::vector<sfm::KeyFrameId> estimateWindow(const sfm::SparseMap& map, double pa
 	}
 	std::reverse(ids.begin(), ids.end());
 	return ids;
+}
+
+/** Overlapping stretches of the path, each `length` long (keyframe centres in id order),
+ * starting every length / 2, the last ending at the newest keyframe; one stretch, every
+ * keyframe, when the path is at most 1.5 x length long. Ascending ids in each. */
+std::vector<std::vector<sfm::KeyFrameId>> pathStretches(const sfm::SparseMap& map, double length)
+{
+	std::vector<std::pair<sfm::KeyFrameId, double>> along;  // keyframe, path length up to it
+	std::optional<Eigen::Vector3d> prev;
+	double travelled = 0;
+	for (const auto& [id, kf] : map.keyframes())
+	{
+		const Eigen::Vector3d c = sfm::translationOf(kf.T_world_cam);
+		if (prev) travelled += (c - *prev).norm();
+		along.emplace_back(id, travelled);
+		prev = c;
+	}
+	std::vector<std::vector<sfm::KeyFrameId>> out;
+	if (!(length > 0) || travelled <= 1.5 * length)
+	{
+		out.emplace_back();
+		for (const auto& [id, s] : along) out.back().push_back(id);
+		return out;
+	}
+	const double step = 0.5 * length;
+	for (double start = 0;; start += step)
+	{
+		const double from = std::min(start, travelled - length);
+		out.emplace_back();
+		for (const auto& [id, s] : along)
+			if (s >= from && s <= from + length) out.back().push_back(id);
+		if (from + length >= travelled) break;
+	}
+	return out;
 }
 
 /** Whether a keyframe of the (sorted) window observes the landmark. */
@@ -177,19 +211,68 @@ sfm::CameraHeightScaleResult MetricScale::estimateOver(
 	return r;
 }
 
+std::optional<sfm::CameraHeightScaleResult> MetricScale::medianOverStretches(
+	const sfm::SparseMap& map, const std::vector<std::vector<sfm::KeyFrameId>>& stretches, std::string& how) const
+{
+	/* A long map is measured stretch by stretch, as the estimates along the run measured it, and
+	 * scaled by the median of the stretches' factors. The final adjustment may leave the map
+	 * slightly bent (a loop's correction spread over its keyframes): then no single plane fits
+	 * its floor, and one plane over the whole map takes the bend's tilt for a change of the
+	 * cameras' height. Each stretch's floor is nearly flat. */
+	std::vector<std::pair<double, std::size_t>> found;  // factor, stretch
+	std::vector<sfm::CameraHeightScaleResult> results;
+	for (std::size_t i = 0; i < stretches.size(); i++)
+	{
+		results.push_back(estimateOver(map, stretches[i], m_windowEstimator));
+		if (results.back().ok) found.emplace_back(results.back().scale, i);
+	}
+	char b[200];
+	std::snprintf(b, sizeof(b), "%zu stretches of %.3g m, %zu with a floor", stretches.size(), m_opts.windowPathLength, found.size());
+	how = b;
+	if (2 * found.size() < stretches.size() || found.size() < 2)
+	{
+		how += ": too few, over the whole map instead";
+		return std::nullopt;
+	}
+	std::sort(found.begin(), found.end());
+	const auto& [median, at] = found[found.size() / 2];
+	auto r = results[at];
+	// The median stretch's floor orientation, camera_height under the whole map's median
+	// keyframe height once rescaled (conclude() scales the offset by r.scale).
+	std::vector<sfm::KeyFrameId> all;
+	for (const auto& [id, kf] : map.keyframes()) all.push_back(id);
+	r.floorOffset = m_opts.estimator.cameraHeight / median - medianHeight(map, all, r.floorNormal);
+	std::snprintf(b, sizeof(b), " (x%.4f to x%.4f): median", found.front().first, found.back().first);
+	how += b;
+	r.message = how + "; its stretch: " + r.message;
+	return r;
+}
+
 std::optional<MetricScale::Rescale> MetricScale::finalEstimate(sfm::SparseMap& map)
 {
 	if (!m_opts.finalEstimate || !metric() || map.numKeyFrames() < static_cast<std::size_t>(m_opts.estimator.minKeyframes)) return std::nullopt;
 	const auto all = estimateWindow(map, 0.0);
+	const auto stretches = pathStretches(map, m_opts.windowPathLength);
+	std::string how;
+	std::optional<sfm::CameraHeightScaleResult> r;
+	if (stretches.size() > 1) r = medianOverStretches(map, stretches, how);
 	std::size_t pointsSearched = 0;
-	auto r = estimateOver(map, all, m_estimator, &pointsSearched);
-	if (!r.ok) r = estimateOver(map, all, m_windowEstimator);
-	if (r.ok && m_opts.windowMaxChange > 0 && std::abs(r.scale - 1) > m_opts.windowMaxChange)
+	if (!r)
 	{
-		r.ok = false;
-		r.message = "refused: x" + std::to_string(r.scale) + " exceeds window_max_change; " + r.message;
+		// A map within 1.5 stretches (or whose stretches found too few floors): one search over
+		// all of it, the strict bound first.
+		r = estimateOver(map, all, m_estimator, &pointsSearched);
+		if (!r->ok) r = estimateOver(map, all, m_windowEstimator);
+		if (!how.empty()) r->message = how + "; " + r->message;
 	}
-	return conclude(map, r, all, true, "final map, " + std::to_string(all.size()) + " keyframes, " + std::to_string(pointsSearched) + " points: ");
+	if (r->ok && m_opts.windowMaxChange > 0 && std::abs(r->scale - 1) > m_opts.windowMaxChange)
+	{
+		r->ok = false;
+		r->message = "refused: x" + std::to_string(r->scale) + " exceeds window_max_change; " + r->message;
+	}
+	return conclude(
+		map, *r, all, true,
+		"final map, " + std::to_string(all.size()) + " keyframes, " + (pointsSearched ? std::to_string(pointsSearched) + " points: " : ""));
 }
 
 std::optional<MetricScale::Rescale> MetricScale::conclude(

@@ -477,7 +477,8 @@ std::map<std::string, double> System::publishCorrection(const PoseCorrection& c,
 	std::map<std::string, double> seconds;
 	if (!m_maps) return seconds;
 	const std::map<sfm::KeyFrameId, double> noScales;
-	for (const auto& [name, sec] : m_maps->applyCorrection(c.newPoses, c.newScales ? *c.newScales : noScales))
+	const std::map<sfm::KeyFrameId, std::vector<mrpt::math::TPoint3D>> noPoints;
+	for (const auto& [name, sec] : m_maps->applyCorrection(c.newPoses, c.newScales ? *c.newScales : noScales, c.newPoints ? *c.newPoints : noPoints))
 		seconds["map_correction:" + name] = sec;
 	if (c.source == PoseCorrection::Source::LoopClosure) m_maps->notifyLoopClosure();
 	return seconds;
@@ -664,9 +665,12 @@ std::map<std::string, double> System::reanchorMaps(const std::map<sfm::KeyFrameI
 	}
 	FinalMapShift shift;
 	shift.largest = largestDisplacement(before, poses, rc.mapReanchorDepth);
-	shift.reanchored = shift.largest > rc.mapReanchorMinShift;
+	// Keyframes without depth hold triangulated points, which the refinement moved against
+	// their keyframes too: the maps take them as refined (and rebuild for them).
+	const auto refreshed = m_maps->refreshedMapPoints(m_map);
+	shift.reanchored = shift.largest > rc.mapReanchorMinShift || !refreshed.empty();
 	m_finalMapShift = shift;
-	if (shift.reanchored) seconds = publishCorrection({PoseCorrection::Source::FinalRefinement, poses, 0}, nullptr);
+	if (shift.reanchored) seconds = publishCorrection({PoseCorrection::Source::FinalRefinement, poses, 0, nullptr, &refreshed}, nullptr);
 	m_maps->syncLandmarks(m_map, m_cfg.tracker.hoc);
 	return seconds;
 }

@@ -262,8 +262,9 @@ class CISMOccupancyGrid2D : public maps::DepthScanMap, public maps::KeyFrameMap
 	/** The grid reads a keyframe's own map points at insertion, not the landmark set. */
 	void syncLandmarks(const maps::LandmarkSource&) override {}
 	/** Scales the stored rays (camera frame) by correction.scale (with every pose's
-	 * translation) and each named keyframe's rays by its own PoseCorrection::scale, takes
-	 * correction.T_world_floor when given, then rebuilds under the corrected poses of its
+	 * translation) and each named keyframe's rays by its own PoseCorrection::scale, replaces
+	 * the rays of the keyframes in correction.points_world by those points (in the keyframe's
+	 * corrected frame), takes correction.T_world_floor when given, then rebuilds under the corrected poses of its
 	 * keyframes (applyTrajectoryCorrection()); false while the floor frame is unknown (nothing
 	 * integrated yet). Throws std::invalid_argument, before changing anything, for a factor
 	 * that is not positive and finite. */

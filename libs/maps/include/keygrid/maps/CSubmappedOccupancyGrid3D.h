@@ -220,9 +220,12 @@ class CSubmappedOccupancyGrid3D : public maps::DepthScanMap, public maps::KeyFra
 	/** A grid built from map points (builtFromMapPoints()): the world scaled by `worldScale`
 	 * about its origin (every keyframe's stored points and translation, its travelled
 	 * distance), then each keyframe of `corr` at its corrected pose with its points scaled by
-	 * its PoseCorrection::scale; the keyframes' points re-integrated, in id order, into one
+	 * its PoseCorrection::scale, and the keyframes of `newPoints` with those world points
+	 * instead of their stored ones; the keyframes' points re-integrated, in id order, into one
 	 * submap. Throws std::logic_error for a grid not built from map points. */
-	ReintegrationStats rebuildFromMapPoints(const TrajectoryCorrection& corr, double worldScale = 1.0);
+	ReintegrationStats rebuildFromMapPoints(
+		const TrajectoryCorrection& corr, double worldScale = 1.0,
+		const std::map<uint64_t, std::vector<mrpt::math::TPoint3D>>& newPoints = {});
 	/** @} */
 
 	/** @name In a SLAM run (maps::KeyFrameMap)

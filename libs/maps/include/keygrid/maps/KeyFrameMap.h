@@ -58,6 +58,11 @@ struct MapCorrection
 	 * poses[id].scale), and so does the translation of every keyframe pose the correction does
 	 * not name. 1 for a loop closure or a refinement. */
 	double scale{1.0};
+	/** Keyframes whose map points the run re-estimated (a map without depth after its final
+	 * bundle adjustment): each one's points as the map holds them now, in the world after the
+	 * correction. A map that keeps points per keyframe replaces that keyframe's with them; the
+	 * others keep what they hold (moved with the pose). Empty for any other correction. */
+	std::map<uint64_t, std::vector<mrpt::math::TPoint3D>> points_world;
 };
 
 /** The frontend's landmarks (positions, descriptors, Histograms of Oriented Cameras) as a HOC

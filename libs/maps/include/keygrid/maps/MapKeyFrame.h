@@ -42,4 +42,9 @@ class MapKeyFrame
 	mutable mrpt::obs::CObservation3DRangeScan::Ptr m_depthScan;
 };
 
+/** World points in the optical frame of a camera at T_world_cam (what the grids store of a
+ * keyframe's map points). */
+std::vector<mrpt::math::TPoint3Df> toCameraFrame(
+	const mrpt::poses::CPose3D& T_world_cam, const std::vector<mrpt::math::TPoint3D>& points_world);
+
 }  // namespace keygrid::maps

@@ -60,6 +60,12 @@ struct MapFeedOptions : public core::FieldTableOptions<MapFeedOptions>
 	 * obstacle band or reach under a wall. Points with depth (RGB-D keyframes) always pass;
 	 * 0 = every point (Default: 0) */
 	double sparseMinParallaxDeg{0.0};
+	/** After the final refinement the maps take the map points of keyframes without depth as
+	 * the refined map holds them, not as they were when each keyframe was inserted: those
+	 * points are triangulations that later bundle adjustments moved against their keyframe
+	 * (a map distorted online would otherwise keep a distorted grid). Keyframes with depth keep
+	 * their measured points (Default: true) */
+	bool refreshFinalPoints{true};
 
 	/** The [maps] keys. */
 	core::OptionFields fields();
@@ -139,12 +145,18 @@ class MetricMaps
 	 * observations, the 3D grid morphed and merged (rebuilt from its stored map points when
 	 * it was built from them). `newScales` (kf id -> factor, absent: 1) is a Sim(3)
 	 * correction's scale per keyframe (monocular loop closing): what a map and the floor
-	 * estimate hold in that keyframe's camera frame grows by it.
+	 * estimate hold in that keyframe's camera frame grows by it. `newPoints` (kf id -> world
+	 * points, see refreshedMapPoints) replace what the grids hold of those keyframes.
 	 * Returns seconds spent per map name ("floor" and each map that re-anchored). Throws
 	 * std::invalid_argument for a factor that is not positive and finite. */
 	std::map<std::string, double> applyCorrection(
 		const std::map<sfm::KeyFrameId, mrpt::poses::CPose3D>& newPoses,
-		const std::map<sfm::KeyFrameId, double>& newScales = {});
+		const std::map<sfm::KeyFrameId, double>& newScales = {},
+		const std::map<sfm::KeyFrameId, std::vector<mrpt::math::TPoint3D>>& newPoints = {});
+	/** With [maps] refresh_final_points: per inserted keyframe still in `map` and without
+	 * depth, its map points as `map` holds them now (the points the maps take of a keyframe,
+	 * see mapKeyFrame), for applyCorrection's newPoints; empty otherwise. */
+	std::map<sfm::KeyFrameId, std::vector<mrpt::math::TPoint3D>> refreshedMapPoints(const sfm::SparseMap& map) const;
 
 	/** Copies the frontend's landmarks (positions, descriptors, histograms) into every
 	 * hocPointsMap; its descriptor options become `hoc` (the frontend's [hoc] section), so the
@@ -189,6 +201,8 @@ class MetricMaps
 	/** Fills m_keyFrameMaps from m_maps (one dynamic_cast per map). */
 	void listKeyFrameMaps();
 	/** Keyframe `id` as the maps take it, as it is now in `map`. */
+	/** The map points the maps take of keyframe `id` (sparse_min_parallax_deg), in the world. */
+	std::vector<mrpt::math::TPoint3D> mapPointsOf(const sfm::SparseMap& map, sfm::KeyFrameId id) const;
 	maps::MapKeyFrame mapKeyFrame(const sfm::SparseMap& map, sfm::KeyFrameId id, double travelled) const;
 	/** The keyframe's depth, from m_images when the keyframe dropped it. */
 	cv::Mat depthOf(const sfm::KeyFrame& kf) const;

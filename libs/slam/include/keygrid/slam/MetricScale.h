@@ -89,8 +89,8 @@ struct MetricScaleOptions : public core::FieldTableOptions<MetricScaleOptions>
 	 * window_max_change / 2 (their largest and smallest factor): a drift the whole map cannot
 	 * confirm, its earlier part being at another scale. 0 = never (Default: 3) */
 	int windowPersistentShrink{3};
-	/** After the run's final bundle adjustment, estimate the scale once more over the whole map
-	 * and rescale it (MetricScale::finalEstimate): that adjustment reshapes the map, and its
+	/** After the run's final bundle adjustment, estimate the scale once more and rescale the
+	 * whole map (MetricScale::finalEstimate): that adjustment reshapes the map, and its
 	 * overall scale is free (a map without depth) (Default: true) */
 	bool finalEstimate{true};
 
@@ -124,10 +124,13 @@ class MetricScale
 	 * or its newest stretch) and says how; nullopt when nothing was applied. The caller holds
 	 * the map's lock. */
 	std::optional<Rescale> update(sfm::SparseMap& map);
-	/** After the run's final bundle adjustment: estimates the scale over the whole map (when
-	 * the strict search finds no clear floor, with window_max_below_share) and rescales the
+	/** After the run's final bundle adjustment: estimates the map's scale and rescales the
 	 * whole map when the change is at most window_max_change; nullopt otherwise, and for a map
-	 * not metric yet. The caller holds the map's lock. */
+	 * not metric yet. A path longer than 1.5 window_path_length is cut into stretches of
+	 * window_path_length starting every half of it, each searched as the newest stretch is
+	 * during the run; the factor is their median, when at least two and at least half of them
+	 * found a floor. Otherwise the whole map is searched (when the strict search finds no clear
+	 * floor, with window_max_below_share). The caller holds the map's lock. */
 	std::optional<Rescale> finalEstimate(sfm::SparseMap& map);
 	/** The map's scale changed in places (a Sim(3) loop correction, which keeps the units of the
 	 * map's first keyframe): the next update() estimates, whenever the last estimate was. The
@@ -170,6 +173,12 @@ class MetricScale
 	sfm::CameraHeightScaleResult estimateOver(
 		const sfm::SparseMap& map, const std::vector<sfm::KeyFrameId>& keyframes,
 		const sfm::CameraHeightScaleEstimator& estimator, std::size_t* pointsSearched = nullptr) const;
+
+	/** finalEstimate() of a long map: the estimate of the stretch (ascending ids each) with the
+	 * median factor, its floor offset set for the whole map; nullopt when fewer than two or
+	 * than half of the stretches found a floor. `how` says what was found, for the log. */
+	std::optional<sfm::CameraHeightScaleResult> medianOverStretches(
+		const sfm::SparseMap& map, const std::vector<std::vector<sfm::KeyFrameId>>& stretches, std::string& how) const;
 
 	/** Counts the estimate `r` over `window` (all keyframes when wholeMap) and, when it
 	 * succeeded, applies it (the whole map, or the window alone) and sets the floor plane; logs

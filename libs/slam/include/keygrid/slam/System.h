@@ -251,6 +251,9 @@ class System
 		/** Monocular loop closure (Sim(3)): per keyframe of newPoses, the factor its
 		 * camera-frame content grows by (LoopClosureEvent::newScales); null or absent: 1 */
 		const std::map<sfm::KeyFrameId, double>* newScales{nullptr};
+		/** FinalRefinement of keyframes without depth: their map points as refined
+		 * (MetricMaps::refreshedMapPoints); null: the maps keep what they hold */
+		const std::map<sfm::KeyFrameId, std::vector<mrpt::math::TPoint3D>>* newPoints{nullptr};
 	};
 	/** The one place a correction goes out: the map's correction count and the tracker (loop
 	 * closures), the frame `tf` that created the keyframe (sequential mode, else null), the
