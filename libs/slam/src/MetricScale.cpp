@@ -58,8 +58,8 @@ std::vector<sfm::KeyFrameId> estimateWindow(const sfm::SparseMap& map, double pa
 }
 
 /** Overlapping stretches of the path, each `length` long (keyframe centres in id order),
- * starting every length / 2, the last ending at the newest keyframe; one stretch, every
- * keyframe, when the path is at most 1.5 x length long. Ascending ids in each. */
+ * starting every length / 2, the last ending at the newest keyframe; none when the path is at
+ * most 1.5 x length long. Ascending ids in each. */
 std::vector<std::vector<sfm::KeyFrameId>> pathStretches(const sfm::SparseMap& map, double length)
 {
 	std::vector<std::pair<sfm::KeyFrameId, double>> along;  // keyframe, path length up to it
@@ -73,12 +73,7 @@ std::vector<std::vector<sfm::KeyFrameId>> pathStretches(const sfm::SparseMap& ma
 		prev = c;
 	}
 	std::vector<std::vector<sfm::KeyFrameId>> out;
-	if (!(length > 0) || travelled <= 1.5 * length)
-	{
-		out.emplace_back();
-		for (const auto& [id, s] : along) out.back().push_back(id);
-		return out;
-	}
+	if (!(length > 0) || travelled <= 1.5 * length) return out;
 	const double step = 0.5 * length;
 	for (double start = 0;; start += step)
 	{
@@ -212,7 +207,8 @@ sfm::CameraHeightScaleResult MetricScale::estimateOver(
 }
 
 std::optional<sfm::CameraHeightScaleResult> MetricScale::medianOverStretches(
-	const sfm::SparseMap& map, const std::vector<std::vector<sfm::KeyFrameId>>& stretches, std::string& how) const
+	const sfm::SparseMap& map, const std::vector<std::vector<sfm::KeyFrameId>>& stretches, const std::vector<sfm::KeyFrameId>& all,
+	std::string& how) const
 {
 	/* A long map is measured stretch by stretch, as the estimates along the run measured it, and
 	 * scaled by the median of the stretches' factors. The final adjustment may leave the map
@@ -239,8 +235,6 @@ std::optional<sfm::CameraHeightScaleResult> MetricScale::medianOverStretches(
 	auto r = results[at];
 	// The median stretch's floor orientation, camera_height under the whole map's median
 	// keyframe height once rescaled (conclude() scales the offset by r.scale).
-	std::vector<sfm::KeyFrameId> all;
-	for (const auto& [id, kf] : map.keyframes()) all.push_back(id);
 	r.floorOffset = m_opts.estimator.cameraHeight / median - medianHeight(map, all, r.floorNormal);
 	std::snprintf(b, sizeof(b), " (x%.4f to x%.4f): median", found.front().first, found.back().first);
 	how += b;
@@ -255,7 +249,7 @@ std::optional<MetricScale::Rescale> MetricScale::finalEstimate(sfm::SparseMap& m
 	const auto stretches = pathStretches(map, m_opts.windowPathLength);
 	std::string how;
 	std::optional<sfm::CameraHeightScaleResult> r;
-	if (stretches.size() > 1) r = medianOverStretches(map, stretches, how);
+	if (!stretches.empty()) r = medianOverStretches(map, stretches, all, how);
 	std::size_t pointsSearched = 0;
 	if (!r)
 	{

@@ -175,10 +175,12 @@ class MetricScale
 		const sfm::CameraHeightScaleEstimator& estimator, std::size_t* pointsSearched = nullptr) const;
 
 	/** finalEstimate() of a long map: the estimate of the stretch (ascending ids each) with the
-	 * median factor, its floor offset set for the whole map; nullopt when fewer than two or
-	 * than half of the stretches found a floor. `how` says what was found, for the log. */
+	 * median factor, its floor offset set for `all` the map's keyframes; nullopt when fewer
+	 * than two or than half of the stretches found a floor. `how` says what was found, for
+	 * the log. */
 	std::optional<sfm::CameraHeightScaleResult> medianOverStretches(
-		const sfm::SparseMap& map, const std::vector<std::vector<sfm::KeyFrameId>>& stretches, std::string& how) const;
+		const sfm::SparseMap& map, const std::vector<std::vector<sfm::KeyFrameId>>& stretches,
+		const std::vector<sfm::KeyFrameId>& all, std::string& how) const;
 
 	/** Counts the estimate `r` over `window` (all keyframes when wholeMap) and, when it
 	 * succeeded, applies it (the whole map, or the window alone) and sets the floor plane; logs
